@@ -1,0 +1,91 @@
+#include "cl/cl_error.h"
+
+#include <filesystem>
+
+namespace mcrt {
+
+std::string cl_error_name(cl_int code) {
+    switch (code) {
+#define MCRT_CL_CODE(name) \
+    case name:             \
+        return #name;
+        MCRT_CL_CODE(CL_SUCCESS)
+        MCRT_CL_CODE(CL_DEVICE_NOT_FOUND)
+        MCRT_CL_CODE(CL_DEVICE_NOT_AVAILABLE)
+        MCRT_CL_CODE(CL_COMPILER_NOT_AVAILABLE)
+        MCRT_CL_CODE(CL_MEM_OBJECT_ALLOCATION_FAILURE)
+        MCRT_CL_CODE(CL_OUT_OF_RESOURCES)
+        MCRT_CL_CODE(CL_OUT_OF_HOST_MEMORY)
+        MCRT_CL_CODE(CL_PROFILING_INFO_NOT_AVAILABLE)
+        MCRT_CL_CODE(CL_MEM_COPY_OVERLAP)
+        MCRT_CL_CODE(CL_IMAGE_FORMAT_MISMATCH)
+        MCRT_CL_CODE(CL_IMAGE_FORMAT_NOT_SUPPORTED)
+        MCRT_CL_CODE(CL_BUILD_PROGRAM_FAILURE)
+        MCRT_CL_CODE(CL_MAP_FAILURE)
+        MCRT_CL_CODE(CL_MISALIGNED_SUB_BUFFER_OFFSET)
+        MCRT_CL_CODE(CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST)
+        MCRT_CL_CODE(CL_COMPILE_PROGRAM_FAILURE)
+        MCRT_CL_CODE(CL_LINKER_NOT_AVAILABLE)
+        MCRT_CL_CODE(CL_LINK_PROGRAM_FAILURE)
+        MCRT_CL_CODE(CL_DEVICE_PARTITION_FAILED)
+        MCRT_CL_CODE(CL_KERNEL_ARG_INFO_NOT_AVAILABLE)
+        MCRT_CL_CODE(CL_INVALID_VALUE)
+        MCRT_CL_CODE(CL_INVALID_DEVICE_TYPE)
+        MCRT_CL_CODE(CL_INVALID_PLATFORM)
+        MCRT_CL_CODE(CL_INVALID_DEVICE)
+        MCRT_CL_CODE(CL_INVALID_CONTEXT)
+        MCRT_CL_CODE(CL_INVALID_QUEUE_PROPERTIES)
+        MCRT_CL_CODE(CL_INVALID_COMMAND_QUEUE)
+        MCRT_CL_CODE(CL_INVALID_HOST_PTR)
+        MCRT_CL_CODE(CL_INVALID_MEM_OBJECT)
+        MCRT_CL_CODE(CL_INVALID_IMAGE_FORMAT_DESCRIPTOR)
+        MCRT_CL_CODE(CL_INVALID_IMAGE_SIZE)
+        MCRT_CL_CODE(CL_INVALID_SAMPLER)
+        MCRT_CL_CODE(CL_INVALID_BINARY)
+        MCRT_CL_CODE(CL_INVALID_BUILD_OPTIONS)
+        MCRT_CL_CODE(CL_INVALID_PROGRAM)
+        MCRT_CL_CODE(CL_INVALID_PROGRAM_EXECUTABLE)
+        MCRT_CL_CODE(CL_INVALID_KERNEL_NAME)
+        MCRT_CL_CODE(CL_INVALID_KERNEL_DEFINITION)
+        MCRT_CL_CODE(CL_INVALID_KERNEL)
+        MCRT_CL_CODE(CL_INVALID_ARG_INDEX)
+        MCRT_CL_CODE(CL_INVALID_ARG_VALUE)
+        MCRT_CL_CODE(CL_INVALID_ARG_SIZE)
+        MCRT_CL_CODE(CL_INVALID_KERNEL_ARGS)
+        MCRT_CL_CODE(CL_INVALID_WORK_DIMENSION)
+        MCRT_CL_CODE(CL_INVALID_WORK_GROUP_SIZE)
+        MCRT_CL_CODE(CL_INVALID_WORK_ITEM_SIZE)
+        MCRT_CL_CODE(CL_INVALID_GLOBAL_OFFSET)
+        MCRT_CL_CODE(CL_INVALID_EVENT_WAIT_LIST)
+        MCRT_CL_CODE(CL_INVALID_EVENT)
+        MCRT_CL_CODE(CL_INVALID_OPERATION)
+        MCRT_CL_CODE(CL_INVALID_GL_OBJECT)
+        MCRT_CL_CODE(CL_INVALID_BUFFER_SIZE)
+        MCRT_CL_CODE(CL_INVALID_MIP_LEVEL)
+        MCRT_CL_CODE(CL_INVALID_GLOBAL_WORK_SIZE)
+        MCRT_CL_CODE(CL_INVALID_PROPERTY)
+        MCRT_CL_CODE(CL_INVALID_IMAGE_DESCRIPTOR)
+        MCRT_CL_CODE(CL_INVALID_COMPILER_OPTIONS)
+        MCRT_CL_CODE(CL_INVALID_LINKER_OPTIONS)
+        MCRT_CL_CODE(CL_INVALID_DEVICE_PARTITION_COUNT)
+#undef MCRT_CL_CODE
+        case -1001:
+            return "CL_PLATFORM_NOT_FOUND_KHR";
+        default:
+            return "CL_UNKNOWN_ERROR(" + std::to_string(code) + ")";
+    }
+}
+
+static std::string describe(const std::string& call, cl_int code, const char* file, int line) {
+    return call + " failed with " + cl_error_name(code) + " (" +
+           std::filesystem::path(file).filename().string() + ":" + std::to_string(line) + ")";
+}
+
+ClError::ClError(const std::string& call, cl_int code_, const char* file, int line)
+    : RuntimeError(describe(call, code_, file, line)), code(code_) {}
+
+void throw_cl_error(const char* call, cl_int code, const char* file, int line) {
+    throw ClError(call, code, file, line);
+}
+
+}  // namespace mcrt

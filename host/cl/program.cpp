@@ -1,0 +1,83 @@
+#include "cl/program.h"
+
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "cl/cl_error.h"
+
+namespace mcrt {
+
+const std::map<std::string, std::string>& embedded_kernel_files();  // generated at build time
+
+static std::string read_kernel_file(const std::string& name) {
+    if (const char* dir = std::getenv("MCRT_KERNEL_DIR"); dir && *dir) {
+        std::ifstream in(std::string(dir) + "/" + name, std::ios::binary);
+        if (!in) throw RuntimeError("kernel file not found: " + std::string(dir) + "/" + name);
+        std::ostringstream text;
+        text << in.rdbuf();
+        return text.str();
+    }
+    const auto& files = embedded_kernel_files();
+    auto it = files.find(name);
+    if (it == files.end()) throw RuntimeError("kernel file not embedded: " + name);
+    return it->second;
+}
+
+// Expands `#include "name"` lines; a file already expanded is skipped the second time.
+static void expand(const std::string& name, std::set<std::string>& seen, std::string& out) {
+    if (!seen.insert(name).second) return;
+    std::istringstream in(read_kernel_file(name));
+    out += "#line 1 \"" + name + "\"\n";
+    std::string line;
+    int line_number = 0;
+    while (std::getline(in, line)) {
+        ++line_number;
+        size_t start = line.find_first_not_of(" \t");
+        if (start != std::string::npos && line.compare(start, 8, "#include") == 0) {
+            size_t open = line.find('"', start);
+            size_t close = open == std::string::npos ? open : line.find('"', open + 1);
+            if (close != std::string::npos) {
+                expand(line.substr(open + 1, close - open - 1), seen, out);
+                out += "#line " + std::to_string(line_number + 1) + " \"" + name + "\"\n";
+                continue;
+            }
+        }
+        out += line;
+        out += '\n';
+    }
+}
+
+std::string kernel_source(const std::string& file) {
+    std::set<std::string> seen;
+    std::string out;
+    expand(file, seen, out);
+    return out;
+}
+
+cl::Program build_program(const cl::Context& context, const cl::Device& device,
+                          const std::string& source, const std::string& options) {
+    cl_int status = CL_SUCCESS;
+    cl::Program program(context, source, false, &status);
+    CL_CHECK_STATUS(status, "clCreateProgramWithSource");
+    status = program.build(std::vector<cl::Device>{device}, options.c_str());
+    if (status != CL_SUCCESS) {
+        std::string log, name;
+        program.getBuildInfo(device, CL_PROGRAM_BUILD_LOG, &log);
+        device.getInfo(CL_DEVICE_NAME, &name);
+        throw RuntimeError("kernel build failed on '" + name + "' (" + cl_error_name(status) +
+                           ", options '" + options + "'):\n" + log);
+    }
+    return program;
+}
+
+cl::Kernel make_kernel(const cl::Program& program, const char* name) {
+    cl_int status = CL_SUCCESS;
+    cl::Kernel kernel(program, name, &status);
+    CL_CHECK_STATUS(status, (std::string("clCreateKernel(") + name + ")").c_str());
+    return kernel;
+}
+
+}  // namespace mcrt

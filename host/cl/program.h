@@ -1,0 +1,24 @@
+// OpenCL program sources (embedded or from disk) and their compilation.
+#pragma once
+
+#include <string>
+
+#include <CL/opencl.hpp>
+
+namespace mcrt {
+
+// Source of kernels/<file> with every #include "..." expanded once (include guards are not
+// needed) and #line markers, so build errors name the right file and line. The files are those
+// embedded at build time, or those of $MCRT_KERNEL_DIR when set (development override).
+// Throws RuntimeError when a file is missing.
+std::string kernel_source(const std::string& file);
+
+// Builds source for the context's device with the options. A failing build throws
+// RuntimeError carrying the device name and the build log.
+cl::Program build_program(const cl::Context& context, const cl::Device& device,
+                          const std::string& source, const std::string& options);
+
+// A kernel by name, throwing ClError.
+cl::Kernel make_kernel(const cl::Program& program, const char* name);
+
+}  // namespace mcrt

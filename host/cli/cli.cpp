@@ -1,0 +1,288 @@
+#include "cli/cli.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <set>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "bvh/bvh.h"
+#include "cl/cl_error.h"
+#include "cl/device.h"
+#include "cli/progress.h"
+#include "common/atomic_file.h"
+#include "common/error.h"
+#include "image/image.h"
+#include "render/renderer.h"
+#include "scene/gltf_import.h"
+
+namespace mcrt {
+namespace {
+
+void print_warning(const std::string& message) {
+    std::cerr << "mcrt: warning: " << message << std::endl;
+}
+
+struct RenderOptions {
+    std::string scene, out, png, stats;
+    int width = 512, height = 512;
+    uint32_t spp = 16;
+    std::string estimator = "light-area", light_select = "power", sampler = "independent";
+    uint32_t seed = 0;
+    std::string sky = "1";
+    float ao_distance = 0.0f;
+    int camera = -1;
+    std::vector<std::string> devices;
+    uint32_t batch = 0;
+    double time_limit = 0.0;
+    float exposure = 0.0f;
+    bool quiet = false;
+};
+
+const std::vector<std::string> kEstimators = {
+    "hemisphere-uniform", "hemisphere-cosine", "light-area",      "light-solid-angle", "mis",
+    "ambient-uniform",    "ambient-cosine",    "ambient-fibonacci"};
+
+// An output's directory must exist before rendering starts, not after.
+void check_output_path(const std::string& path, const char* option) {
+    if (path.empty()) return;
+    std::filesystem::path dir = std::filesystem::path(path).parent_path();
+    if (!dir.empty() && !std::filesystem::is_directory(dir))
+        throw InputError(std::string(option) + " " + path + ": directory " + dir.string() +
+                         " does not exist");
+}
+
+// Devices named by --device (index, cpu, gpu, all; repeatable), in list order, no duplicates.
+std::vector<DeviceInfo> select_devices(const std::vector<std::string>& specs) {
+    std::vector<DeviceInfo> all = enumerate_devices(print_warning);
+    if (all.empty()) throw RuntimeError("no OpenCL device found (is an ICD such as PoCL installed?)");
+    if (specs.empty()) return {all.front()};
+    std::set<int> chosen;
+    for (const std::string& spec : specs) {
+        bool matched = false;
+        for (const DeviceInfo& d : all) {
+            bool match = spec == "all" || (spec == "cpu" && d.type_name() == "cpu") ||
+                         (spec == "gpu" && d.type_name() == "gpu") ||
+                         spec == std::to_string(d.index);
+            if (match) chosen.insert(d.index), matched = true;
+        }
+        if (!matched) {
+            bool numeric = !spec.empty() && spec.find_first_not_of("0123456789") == std::string::npos;
+            std::string why = numeric ? "no such device (" + std::to_string(all.size()) +
+                                            " found; see `mcrt devices`)"
+                                      : "expected a device index, cpu, gpu or all";
+            if (spec == "cpu" || spec == "gpu") throw RuntimeError("--device " + spec + ": no " + spec + " device found");
+            throw InputError("--device " + spec + ": " + why);
+        }
+    }
+    std::vector<DeviceInfo> result;
+    for (int i : chosen) result.push_back(all[size_t(i)]);
+    return result;
+}
+
+glm::vec3 parse_sky(const std::string& text) {
+    std::vector<float> v;
+    std::stringstream in(text);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        try {
+            size_t used = 0;
+            float x = std::stof(item, &used);
+            if (used != item.size() || !std::isfinite(x) || x < 0) throw std::invalid_argument(item);
+            v.push_back(x);
+        } catch (const std::exception&) {
+            throw InputError("--sky " + text + ": expected R,G,B or one value, finite and >= 0");
+        }
+    }
+    if (v.size() == 1) return glm::vec3(v[0]);
+    if (v.size() == 3) return glm::vec3(v[0], v[1], v[2]);
+    throw InputError("--sky " + text + ": expected R,G,B or one value");
+}
+
+int run_devices() {
+    std::vector<DeviceInfo> devices = enumerate_devices(print_warning);
+    if (devices.empty()) throw RuntimeError("no OpenCL device found (is an ICD such as PoCL installed?)");
+    for (const DeviceInfo& d : devices) {
+        std::printf("%d: %s [%s] — %s, %s, %u compute units, %.1f GiB, driver %s\n", d.index,
+                    d.name.c_str(), d.type_name().c_str(), d.platform_name.c_str(),
+                    d.version.c_str(), d.compute_units, double(d.global_memory) / (1 << 30),
+                    d.driver_version.c_str());
+    }
+    return 0;
+}
+
+int run_render(const RenderOptions& o) {
+    auto start = std::chrono::steady_clock::now();
+    if (o.sampler != "independent") throw InputError("--sampler " + o.sampler + ": not yet supported");
+    if (o.time_limit > 0) throw InputError("--time-limit: not yet supported");
+    parse_sky(o.sky);  // validated now; used by the ambient estimators
+    check_output_path(o.out, "--out");
+    check_output_path(o.png, "--png");
+    check_output_path(o.stats, "--stats");
+
+    RenderSettings settings;
+    settings.width = o.width;
+    settings.height = o.height;
+    settings.spp = o.spp;
+    settings.estimator = o.estimator;
+    settings.light_select = o.light_select == "uniform" ? LightSelect::Uniform : LightSelect::Power;
+    settings.seed = o.seed;
+    settings.batch = o.batch;
+    render_program_options(settings);  // rejects what is not supported before any work
+
+    Scene scene = load_gltf(o.scene, print_warning);
+    if (scene.triangle_count() == 0) print_warning(o.scene + ": the scene has no triangles");
+    if (collect_emitters(scene).empty())
+        print_warning(o.scene + ": no emissive triangles: direct lighting is black");
+    Camera camera;
+    if (o.camera >= 0) {
+        if (size_t(o.camera) >= scene.cameras.size())
+            throw InputError("--camera " + std::to_string(o.camera) + ": " + o.scene + " has " +
+                             std::to_string(scene.cameras.size()) + " perspective camera(s)");
+        camera = scene.cameras[size_t(o.camera)];
+    } else {
+        camera = scene.cameras.empty() ? bench_camera(scene) : scene.cameras.front();
+    }
+
+    std::vector<DeviceInfo> devices = select_devices(o.devices);
+    if (devices.size() > 1) throw InputError("--device: rendering on several devices is not yet supported");
+    DeviceContext device(devices.front());
+
+    Bvh bvh = build_bvh(scene);
+    GpuSceneData gpu_scene = make_gpu_scene(scene, bvh, camera, o.width, o.height);
+
+    ProgressBar bar(!o.quiet, uint64_t(o.width) * o.height);
+    RenderResult result = render(device, gpu_scene, settings,
+                                 [&](uint32_t done, uint32_t total) { bar.update(done, total); });
+    bar.finish();
+
+    std::map<std::string, std::string> attributes = {
+        {"mcrt.scene", o.scene},         {"mcrt.estimator", o.estimator},
+        {"mcrt.light_select", o.light_select}, {"mcrt.sampler", o.sampler},
+        {"mcrt.seed", std::to_string(o.seed)}};
+    write_exr(o.out, result.image, attributes);
+    if (!o.png.empty()) write_png(o.png, result.image, o.exposure);
+
+    double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!o.stats.empty()) {
+        uint64_t samples = uint64_t(o.width) * o.height * o.spp;
+        nlohmann::json j = {
+            {"scene", o.scene},
+            {"width", o.width},
+            {"height", o.height},
+            {"spp", o.spp},
+            {"estimator", o.estimator},
+            {"light_select", o.light_select},
+            {"sampler", o.sampler},
+            {"seed", o.seed},
+            {"seconds_total", total},
+            {"seconds_render", result.seconds_render},
+            {"seconds_kernel_build", result.seconds_build},
+            {"seconds_bvh_build", bvh.stats.build_seconds},
+            {"samples_per_second", result.seconds_render > 0 ? samples / result.seconds_render : 0.0},
+            {"rays", result.rays},
+            {"rays_per_second", result.seconds_render > 0 ? result.rays / result.seconds_render : 0.0},
+            {"nan_samples", result.nan_samples},
+            {"triangles", scene.triangle_count()},
+            {"lights", gpu_scene.lights.size()},
+            {"bvh", {{"nodes", bvh.nodes.size()}, {"sah_cost", bvh.stats.sah_cost},
+                     {"depth", bvh.stats.depth}, {"bytes", bvh.stats.bytes}}},
+        };
+        nlohmann::json devices_json = nlohmann::json::array();
+        for (const DeviceReport& d : result.devices)
+            devices_json.push_back({{"name", d.name}, {"samples", d.samples}, {"batches", d.batches},
+                                    {"seconds_busy", d.seconds_busy},
+                                    {"samples_per_second", d.seconds_busy > 0 ? d.samples / d.seconds_busy : 0.0}});
+        j["devices"] = devices_json;
+        write_atomically(o.stats, [&](const std::string& tmp) {
+            std::ofstream out(tmp);
+            out << j.dump(2) << "\n";
+            if (!out) throw RuntimeError(o.stats + ": cannot write");
+        });
+    }
+    if (!o.quiet)
+        std::cerr << "mcrt: wrote " << o.out << " (" << o.width << "x" << o.height << ", "
+                  << o.spp << " spp, " << result.seconds_render << " s on the device)" << std::endl;
+    return 0;
+}
+
+}  // namespace
+
+int run_cli(int argc, char** argv) {
+    CLI::App app{"mcrt — an OpenCL Monte Carlo renderer for light-transport estimator experiments"};
+    app.require_subcommand(1);
+
+    app.add_subcommand("devices", "list OpenCL platforms and devices, with their index");
+
+    RenderOptions o;
+    CLI::App* render_cmd = app.add_subcommand("render", "render a glTF scene to EXR");
+    render_cmd->add_option("scene", o.scene, "glTF scene (.gltf or .glb)")->required();
+    render_cmd->add_option("--out", o.out, "output EXR")->required();
+    render_cmd->add_option("--png", o.png, "also write an sRGB PNG");
+    render_cmd->add_option("--width", o.width, "image width")->check(CLI::Range(1, 16384));
+    render_cmd->add_option("--height", o.height, "image height")->check(CLI::Range(1, 16384));
+    render_cmd->add_option("--spp", o.spp, "samples per pixel")->check(CLI::Range(1u, 1u << 24));
+    render_cmd->add_option("--estimator", o.estimator, "estimator")->check(CLI::IsMember(kEstimators));
+    render_cmd->add_option("--light-select", o.light_select, "light selection")
+        ->check(CLI::IsMember({"uniform", "power", "alias"}));
+    render_cmd->add_option("--sampler", o.sampler, "sample generator")
+        ->check(CLI::IsMember({"independent", "stratified", "sobol"}));
+    render_cmd->add_option("--seed", o.seed, "random seed");
+    render_cmd->add_option("--sky", o.sky, "sky radiance R,G,B (ambient estimators)");
+    render_cmd->add_option("--ao-distance", o.ao_distance, "ambient occlusion distance, 0 = unbounded")
+        ->check(CLI::Range(0.0f, 3.4e38f));
+    render_cmd->add_option("--camera", o.camera, "camera index in the scene")->check(CLI::Range(0, 1 << 30));
+    render_cmd->add_option("--device", o.devices, "device index, cpu, gpu or all (repeatable)");
+    render_cmd->add_option("--batch", o.batch, "samples per pixel per launch (0 chooses)")
+        ->check(CLI::Range(0u, 1u << 24));
+    render_cmd->add_option("--stats", o.stats, "write statistics as JSON");
+    render_cmd->add_option("--time-limit", o.time_limit, "stop after this many seconds")
+        ->check(CLI::Range(0.0, 1e9));
+    render_cmd->add_option("--exposure", o.exposure, "PNG exposure in stops")->check(CLI::Range(-64.0f, 64.0f));
+    render_cmd->add_flag("--quiet", o.quiet, "no progress output");
+
+    CLI::App* bench_cmd = app.add_subcommand("bench", "time ray queries on a scene");
+    std::string bench_scene;
+    bench_cmd->add_option("scene", bench_scene, "glTF scene")->required();
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        std::cerr << "mcrt: error: " << e.what() << std::endl;
+        return 2;
+    }
+
+    try {
+        if (app.got_subcommand("devices")) return run_devices();
+        if (app.got_subcommand("render")) {
+            if (o.width * int64_t(o.height) * o.spp >= (int64_t(1) << 40))
+                throw InputError("--width × --height × --spp is too large");
+            return run_render(o);
+        }
+        if (app.got_subcommand("bench")) throw InputError("bench: not yet supported");
+    } catch (const InputError& e) {
+        std::cerr << "mcrt: error: " << e.what() << std::endl;
+        return 2;
+    } catch (const RuntimeError& e) {
+        std::cerr << "mcrt: error: " << e.what() << std::endl;
+        return 1;
+    } catch (const std::bad_alloc&) {
+        std::cerr << "\nmcrt: error: out of host memory" << std::endl;
+        return 1;
+    } catch (const std::exception& e) {
+        std::cerr << "mcrt: error: " << e.what() << std::endl;
+        return 1;
+    }
+    return 2;
+}
+
+}  // namespace mcrt

@@ -1,0 +1,36 @@
+#include "cli/progress.h"
+
+#include <cstdio>
+
+namespace mcrt {
+
+ProgressBar::ProgressBar(bool enabled, uint64_t samples_per_spp)
+    : enabled_(enabled), samples_per_spp_(samples_per_spp),
+      start_(std::chrono::steady_clock::now()), last_(start_) {}
+
+void ProgressBar::update(uint32_t done, uint32_t total) {
+    if (!enabled_ || total == 0) return;
+    auto now = std::chrono::steady_clock::now();
+    if (done < total && drawn_ && now - last_ < std::chrono::milliseconds(100)) return;
+    last_ = now;
+    drawn_ = true;
+    double elapsed = std::chrono::duration<double>(now - start_).count();
+    double fraction = double(done) / total;
+    double rate = elapsed > 0 ? double(done) * samples_per_spp_ / elapsed : 0.0;
+    double left = fraction > 0 ? elapsed * (1 - fraction) / fraction : 0.0;
+    const int width = 30;
+    int filled = int(fraction * width + 0.5);
+    char bar[width + 1];
+    for (int k = 0; k < width; ++k) bar[k] = k < filled ? '#' : '.';
+    bar[width] = '\0';
+    std::fprintf(stderr, "\r[%s] %3d%% %u/%u spp  %.2f Msamples/s  %.1f s left ", bar,
+                 int(fraction * 100 + 0.5), done, total, rate * 1e-6, left);
+    std::fflush(stderr);
+}
+
+void ProgressBar::finish() {
+    if (enabled_ && drawn_) std::fputc('\n', stderr);
+    drawn_ = false;
+}
+
+}  // namespace mcrt

@@ -1,0 +1,24 @@
+// A progress bar on stderr: fraction done, samples per second, time left.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+
+namespace mcrt {
+
+class ProgressBar {
+public:
+    ProgressBar(bool enabled, uint64_t samples_per_spp);
+    ~ProgressBar() { finish(); }  // an error message then starts on a line of its own
+    // done of total samples per pixel; redraws at most ten times a second, and at the end.
+    void update(uint32_t done, uint32_t total);
+    void finish();
+
+private:
+    bool enabled_;
+    uint64_t samples_per_spp_;
+    bool drawn_ = false;
+    std::chrono::steady_clock::time_point start_, last_;
+};
+
+}  // namespace mcrt

@@ -1,0 +1,95 @@
+#include "render/gpu_scene.h"
+
+#include <cmath>
+#include <cstring>
+
+#include "cl/cl_error.h"
+
+namespace mcrt {
+
+static float uint_bits(uint32_t u) {
+    float f;
+    std::memcpy(&f, &u, sizeof f);
+    return f;
+}
+
+static gpu::float4 to_float4(const glm::vec3& v, float w = 0.0f) { return {v.x, v.y, v.z, w}; }
+
+gpu::CameraGpu make_gpu_camera(const Camera& camera, int width, int height) {
+    const glm::mat4& m = camera.camera_to_world;
+    float tan_half = std::tan(0.5f * camera.yfov);
+    float aspect = float(width) / float(height);
+    gpu::CameraGpu g{};
+    g.eye = to_float4(glm::vec3(m[3]));
+    g.right = to_float4(glm::normalize(glm::vec3(m[0])) * (tan_half * aspect));
+    g.up = to_float4(glm::normalize(glm::vec3(m[1])) * tan_half);
+    g.forward = to_float4(-glm::normalize(glm::vec3(m[2])));
+    return g;
+}
+
+GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& camera, int width,
+                            int height) {
+    GpuSceneData data;
+    data.nodes = bvh.nodes;
+    data.triangles = bvh.triangles;
+    for (const Material& m : scene.materials) {
+        gpu::Material g{};
+        g.albedo = to_float4(m.albedo);
+        g.Le = to_float4(m.emission);
+        g.flags = m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u;
+        data.materials.push_back(g);
+    }
+    if (data.materials.empty()) data.materials.push_back(gpu::Material{});
+
+    // Power CDF over the emitters (PBRT 3rd ed. 13.3.1), accumulated in double.
+    std::vector<EmissiveTriangle> emitters = collect_emitters(scene);
+    double total_power = 0;
+    for (const EmissiveTriangle& e : emitters) total_power += e.power;
+    data.light_cdf.push_back(0.0f);
+    double running = 0;
+    for (const EmissiveTriangle& e : emitters) {
+        const Material& m = scene.materials[scene.triangle_material[e.triangle]];
+        const glm::vec3* p = &scene.positions[3 * size_t(e.triangle)];
+        gpu::Light light{};
+        light.p0 = to_float4(p[0], e.area);
+        light.p1 = to_float4(p[1], uint_bits(m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u));
+        light.p2 = to_float4(p[2]);
+        light.Le = to_float4(m.emission);
+        data.lights.push_back(light);
+        running += e.power;
+        data.light_cdf.push_back(float(running / total_power));
+    }
+    if (!emitters.empty()) data.light_cdf.back() = 1.0f;
+    data.camera = make_gpu_camera(camera, width, height);
+    return data;
+}
+
+template <typename T>
+static cl::Buffer upload(const DeviceContext& device, const std::vector<T>& items, size_t& bytes,
+                         const char* what) {
+    std::vector<T> padded = items.empty() ? std::vector<T>(1) : std::vector<T>();
+    const std::vector<T>& source = items.empty() ? padded : items;
+    size_t size = source.size() * sizeof(T);
+    if (size > device.info.max_allocation)
+        throw RuntimeError(std::string("scene ") + what + " need " + std::to_string(size) +
+                           " bytes, more than the " + std::to_string(device.info.max_allocation) +
+                           " bytes device '" + device.info.name + "' can allocate at once");
+    cl_int status = CL_SUCCESS;
+    cl::Buffer buffer(device.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, size,
+                      const_cast<T*>(source.data()), &status);
+    CL_CHECK_STATUS(status, (std::string("clCreateBuffer(") + what + ")").c_str());
+    bytes += size;
+    return buffer;
+}
+
+GpuSceneBuffers::GpuSceneBuffers(const DeviceContext& device, const GpuSceneData& data) {
+    nodes = upload(device, data.nodes, bytes, "BVH nodes");
+    triangles = upload(device, data.triangles, bytes, "triangles");
+    materials = upload(device, data.materials, bytes, "materials");
+    lights = upload(device, data.lights, bytes, "lights");
+    light_cdf = upload(device, data.light_cdf, bytes, "light CDF");
+    camera = upload(device, std::vector<gpu::CameraGpu>{data.camera}, bytes, "camera");
+    light_count = cl_uint(data.lights.size());
+}
+
+}  // namespace mcrt

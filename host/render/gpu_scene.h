@@ -1,0 +1,43 @@
+// The scene as the kernels see it: host arrays in the layouts of kernels/shared_types.h, and
+// their buffers on one device.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <CL/opencl.hpp>
+
+#include "bvh/bvh.h"
+#include "cl/device.h"
+#include "scene/scene.h"
+#include "shared_types.h"
+
+namespace mcrt {
+
+enum class LightSelect { Uniform, Power };
+
+struct GpuSceneData {
+    std::vector<gpu::BvhNode> nodes;
+    std::vector<gpu::Triangle> triangles;
+    std::vector<gpu::Material> materials;
+    std::vector<gpu::Light> lights;
+    std::vector<float> light_cdf;  // lights + 1 entries, by power (PBRT 3rd ed. 13.3.1)
+    gpu::CameraGpu camera{};
+};
+
+// The camera of DESIGN.md's camera contract for an image of width × height.
+gpu::CameraGpu make_gpu_camera(const Camera& camera, int width, int height);
+
+// Flattens the scene, its BVH and its emitters; `camera` as chosen by the caller.
+GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& camera, int width,
+                            int height);
+
+// Device copies of GpuSceneData (empty arrays get a one-element buffer, never a null one).
+struct GpuSceneBuffers {
+    GpuSceneBuffers(const DeviceContext& device, const GpuSceneData& data);
+    cl::Buffer nodes, triangles, materials, lights, light_cdf, camera;
+    cl_uint light_count = 0;
+    size_t bytes = 0;
+};
+
+}  // namespace mcrt

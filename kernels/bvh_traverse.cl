@@ -1,0 +1,124 @@
+/* BVH traversal: closest hit for camera rays, any hit for shadow rays. */
+#ifndef MCRT_BVH_TRAVERSE_CL
+#define MCRT_BVH_TRAVERSE_CL
+
+#include "intersect.cl"
+
+/* Matches kMaxBvhDepth on the host: the builder never makes a deeper tree. */
+#define BVH_STACK_SIZE 64
+
+#define NO_HIT 0xffffffffu
+
+typedef struct {
+    float t;
+    float b1, b2;  /* barycentrics of p1, p2 */
+    uint triangle; /* index in the leaf-ordered triangle array, NO_HIT on a miss */
+} Hit;
+
+/* Entry distance of the ray into the box if it enters before t_max, else +huge. Slab test with
+ * min/max: fmin/fmax keep NaN semantics on PoCL and cost four times as much. */
+inline float box_entry(float4 lo, float4 hi, const Ray* r, float t_max) {
+    float3 t0 = (lo.xyz - r->org) * r->inv_dir;
+    float3 t1 = (hi.xyz - r->org) * r->inv_dir;
+    float3 tn = min(t0, t1), tf = max(t0, t1);
+    float t_enter = max(max(tn.x, tn.y), max(tn.z, 0.0f));
+    float t_exit = min(min(tf.x, tf.y), min(tf.z, t_max));
+    return t_enter <= t_exit ? t_enter : MAXFLOAT;
+}
+
+/* Closest hit with t in (0, t_max). */
+inline Hit bvh_closest_hit(global const BvhNode* nodes, global const Triangle* triangles,
+                           const Ray* r, float t_max) {
+    Hit hit;
+    hit.t = t_max;
+    hit.b1 = hit.b2 = 0.0f;
+    hit.triangle = NO_HIT;
+
+    uint stack[BVH_STACK_SIZE];
+    float stack_t[BVH_STACK_SIZE];
+    int sp = 0;
+    BvhNode node = nodes[0];
+    if (box_entry(node.lo, node.hi, r, t_max) == MAXFLOAT) return hit;
+    for (;;) {
+        uint first = as_uint(node.lo.w);
+        uint count = as_uint(node.hi.w);
+        bool descend = false;
+        if (count == 0u) {
+            /* Inner node: visit the nearer child first, push the farther one. */
+            BvhNode left = nodes[first], right = nodes[first + 1u];
+            float tl = box_entry(left.lo, left.hi, r, hit.t);
+            float tr = box_entry(right.lo, right.hi, r, hit.t);
+            if (tl != MAXFLOAT && tr != MAXFLOAT) {
+                bool left_first = tl <= tr;
+                stack[sp] = left_first ? first + 1u : first;
+                stack_t[sp] = left_first ? tr : tl;
+                ++sp;
+                node = left_first ? left : right;
+                descend = true;
+            } else if (tl != MAXFLOAT) {
+                node = left;
+                descend = true;
+            } else if (tr != MAXFLOAT) {
+                node = right;
+                descend = true;
+            }
+        } else {
+            for (uint i = first; i < first + count; ++i) {
+                float t, b1, b2;
+                if (intersect_triangle(r, triangles[i].p0, triangles[i].p1, triangles[i].p2,
+                                       hit.t, &t, &b1, &b2)) {
+                    hit.t = t;
+                    hit.b1 = b1;
+                    hit.b2 = b2;
+                    hit.triangle = i;
+                }
+            }
+        }
+        if (descend) continue;
+        /* Pop, skipping nodes entered beyond the closest hit found since they were pushed. */
+        for (;;) {
+            if (sp == 0) return hit;
+            --sp;
+            if (stack_t[sp] < hit.t) break;
+        }
+        node = nodes[stack[sp]];
+    }
+}
+
+/* True if anything blocks the ray in (0, t_max). */
+inline bool bvh_any_hit(global const BvhNode* nodes, global const Triangle* triangles, const Ray* r,
+                        float t_max) {
+    uint stack[BVH_STACK_SIZE];
+    int sp = 0;
+    BvhNode node = nodes[0];
+    if (box_entry(node.lo, node.hi, r, t_max) == MAXFLOAT) return false;
+    for (;;) {
+        uint first = as_uint(node.lo.w);
+        uint count = as_uint(node.hi.w);
+        if (count == 0u) {
+            BvhNode left = nodes[first], right = nodes[first + 1u];
+            bool hl = box_entry(left.lo, left.hi, r, t_max) != MAXFLOAT;
+            bool hr = box_entry(right.lo, right.hi, r, t_max) != MAXFLOAT;
+            if (hl && hr) {
+                stack[sp++] = first + 1u;
+                node = left;
+                continue;
+            }
+            if (hl || hr) {
+                node = hl ? left : right;
+                continue;
+            }
+        } else {
+            for (uint i = first; i < first + count; ++i) {
+                float t, b1, b2;
+                if (intersect_triangle(r, triangles[i].p0, triangles[i].p1, triangles[i].p2, t_max,
+                                       &t, &b1, &b2))
+                    return true;
+            }
+        }
+        if (sp == 0) return false;
+        node = nodes[stack[--sp]];
+    }
+}
+
+#endif

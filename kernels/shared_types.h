@@ -1,0 +1,74 @@
+/* Structs shared by the host (C++17) and the kernels (OpenCL C 1.2), declared once.
+ * Only float, uint and float4 members; padding explicit; each size stated and checked by a
+ * static_assert on the host and by the `shared_type_sizes` kernel on the device. */
+#ifndef MCRT_SHARED_TYPES_H
+#define MCRT_SHARED_TYPES_H
+
+#ifndef __OPENCL_VERSION__
+#include <cstdint>
+namespace mcrt::gpu {
+struct alignas(16) float4 {
+    float x, y, z, w;
+};
+using uint = std::uint32_t;
+#endif
+
+/* Samples of one pixel are summed in chunks of this many consecutive sample indices, aligned
+ * to multiples of it; batches start on chunk boundaries, so the floating-point sums, and the
+ * image, do not depend on the batch size or the device split. */
+#define MCRT_SAMPLES_PER_CHUNK 16
+
+/* Flat BVH node, 32 bytes. Children of an inner node are adjacent: nodes[first], nodes[first+1].
+ * lo.xyz / hi.xyz: bounds. lo.w: `first` (child or triangle index, as uint bits).
+ * hi.w: triangle count as uint bits; 0 for an inner node. */
+typedef struct {
+    float4 lo;
+    float4 hi;
+} BvhNode;
+
+/* Triangle in BVH leaf order, 48 bytes: world-space vertices, counter-clockwise seen from the
+ * front. p0.w holds the material index as uint bits; p1.w holds the scene's triangle index. */
+typedef struct {
+    float4 p0;
+    float4 p1;
+    float4 p2;
+} Triangle;
+
+#define MATERIAL_DOUBLE_SIDED 1u
+
+/* Lambertian material that may emit, 48 bytes. */
+typedef struct {
+    float4 albedo; /* .xyz reflectance, .w unused */
+    float4 Le;     /* .xyz emitted radiance, .w unused */
+    uint flags;    /* MATERIAL_DOUBLE_SIDED */
+    uint pad0, pad1, pad2;
+} Material;
+
+/* Emissive triangle for light sampling, 64 bytes. */
+typedef struct {
+    float4 p0;  /* .w area */
+    float4 p1;  /* .w uint bits: flags (MATERIAL_DOUBLE_SIDED) */
+    float4 p2;  /* .w unused */
+    float4 Le;  /* .xyz emitted radiance, .w unused (selection pmfs live in the light CDF) */
+} Light;
+
+/* Pinhole camera, 64 bytes. A ray through film point (x, y) in [-1, 1]² (x right, y up) has
+ * direction forward + x·right + y·up, where right and up are already scaled by
+ * tan(yfov/2)·aspect and tan(yfov/2) (DESIGN.md "Camera contract"). */
+typedef struct {
+    float4 eye;
+    float4 right;
+    float4 up;
+    float4 forward;
+} CameraGpu;
+
+#ifndef __OPENCL_VERSION__
+static_assert(sizeof(BvhNode) == 32 && alignof(BvhNode) == 16, "BvhNode layout");
+static_assert(sizeof(Triangle) == 48 && alignof(Triangle) == 16, "Triangle layout");
+static_assert(sizeof(Material) == 48 && alignof(Material) == 16, "Material layout");
+static_assert(sizeof(Light) == 64 && alignof(Light) == 16, "Light layout");
+static_assert(sizeof(CameraGpu) == 64 && alignof(CameraGpu) == 16, "CameraGpu layout");
+}  // namespace mcrt::gpu
+#endif
+
+#endif /* MCRT_SHARED_TYPES_H */

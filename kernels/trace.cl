@@ -1,0 +1,26 @@
+/* Ray-query entry points on rays given in buffers: for tests against a reference tracer and
+ * for `mcrt bench`. */
+#include "shared_types.h"
+#include "bvh_traverse.cl"
+
+/* Closest hit of ray g: origins[g].xyz, directions[g].xyz, t_max in origins[g].w. Writes
+ * hits[g] = (t, b1, b2, leaf-order triangle index as uint bits; NO_HIT on a miss). */
+kernel void trace_closest(global const BvhNode* nodes, global const Triangle* triangles,
+                          global const float4* origins, global const float4* directions,
+                          uint ray_count, global float4* hits) {
+    size_t g = get_global_id(0);
+    if (g >= ray_count) return;
+    Ray r = make_ray(origins[g].xyz, directions[g].xyz);
+    Hit h = bvh_closest_hit(nodes, triangles, &r, origins[g].w);
+    hits[g] = (float4)(h.t, h.b1, h.b2, as_float(h.triangle));
+}
+
+/* Occlusion of ray g in (0, t_max): occluded[g] = 1 if anything blocks it, else 0. */
+kernel void trace_any(global const BvhNode* nodes, global const Triangle* triangles,
+                      global const float4* origins, global const float4* directions,
+                      uint ray_count, global uint* occluded) {
+    size_t g = get_global_id(0);
+    if (g >= ray_count) return;
+    Ray r = make_ray(origins[g].xyz, directions[g].xyz);
+    occluded[g] = bvh_any_hit(nodes, triangles, &r, origins[g].w) ? 1u : 0u;
+}
