@@ -9,6 +9,9 @@
 
 #define NO_HIT 0xffffffffu
 
+/* γ(3) = 3ε / (1 − 3ε), ε = 2^-24 (PBRT 3rd ed. 3.9.1). */
+#define MCRT_GAMMA3 1.7881396e-7f
+
 typedef struct {
     float t;
     float b1, b2;  /* barycentrics of p1, p2 */
@@ -22,9 +25,15 @@ inline float box_entry(float4 lo, float4 hi, const Ray* r, float t_max) {
     float3 t1 = (hi.xyz - r->org) * r->inv_dir;
     float3 tn = min(t0, t1), tf = max(t0, t1);
     float t_enter = max(max(tn.x, tn.y), max(tn.z, 0.0f));
-    float t_exit = min(min(tf.x, tf.y), min(tf.z, t_max));
+    /* Conservative exit so rounding never culls a box the ray grazes (PBRT 3rd ed. 3.9.2). */
+    float t_exit = min(min(tf.x, tf.y), tf.z) * (1.0f + 2.0f * MCRT_GAMMA3);
+    t_exit = min(t_exit, t_max);
     return t_enter <= t_exit ? t_enter : MAXFLOAT;
 }
+
+/* An empty scene's root is a leaf without triangles whose box is inverted (lo > hi); the slab
+ * test would read an inverted box as a huge one, and count 0 would read as an inner node. */
+inline bool root_is_empty(const BvhNode* root) { return root->lo.x > root->hi.x; }
 
 /* Closest hit with t in (0, t_max). */
 inline Hit bvh_closest_hit(global const BvhNode* nodes, global const Triangle* triangles,
@@ -38,7 +47,7 @@ inline Hit bvh_closest_hit(global const BvhNode* nodes, global const Triangle* t
     float stack_t[BVH_STACK_SIZE];
     int sp = 0;
     BvhNode node = nodes[0];
-    if (box_entry(node.lo, node.hi, r, t_max) == MAXFLOAT) return hit;
+    if (root_is_empty(&node) || box_entry(node.lo, node.hi, r, t_max) == MAXFLOAT) return hit;
     for (;;) {
         uint first = as_uint(node.lo.w);
         uint count = as_uint(node.hi.w);
@@ -91,7 +100,7 @@ inline bool bvh_any_hit(global const BvhNode* nodes, global const Triangle* tria
     uint stack[BVH_STACK_SIZE];
     int sp = 0;
     BvhNode node = nodes[0];
-    if (box_entry(node.lo, node.hi, r, t_max) == MAXFLOAT) return false;
+    if (root_is_empty(&node) || box_entry(node.lo, node.hi, r, t_max) == MAXFLOAT) return false;
     for (;;) {
         uint first = as_uint(node.lo.w);
         uint count = as_uint(node.hi.w);

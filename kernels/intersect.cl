@@ -5,6 +5,10 @@
 
 #include "geometry.cl"
 
+/* The edge functions of a shared edge must round identically in both triangles: a fused
+ * multiply-add in one and not the other would open cracks (Woop et al. 2013, sec. 4). */
+#pragma OPENCL FP_CONTRACT OFF
+
 #if defined(cl_khr_fp64)
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 #define MCRT_HAVE_FP64 1
