@@ -120,6 +120,7 @@ int run_render(const RenderOptions& o) {
     auto start = std::chrono::steady_clock::now();
     if (o.sampler != "independent") throw InputError("--sampler " + o.sampler + ": not yet supported");
     if (o.time_limit > 0) throw InputError("--time-limit: not yet supported");
+    if (o.light_select == "alias") throw InputError("--light-select alias: not yet supported");
     parse_sky(o.sky);  // validated now; used by the ambient estimators
     check_output_path(o.out, "--out");
     check_output_path(o.png, "--png");
@@ -224,26 +225,26 @@ int run_cli(int argc, char** argv) {
     render_cmd->add_option("scene", o.scene, "glTF scene (.gltf or .glb)")->required();
     render_cmd->add_option("--out", o.out, "output EXR")->required();
     render_cmd->add_option("--png", o.png, "also write an sRGB PNG");
-    render_cmd->add_option("--width", o.width, "image width")->check(CLI::Range(1, 16384));
-    render_cmd->add_option("--height", o.height, "image height")->check(CLI::Range(1, 16384));
-    render_cmd->add_option("--spp", o.spp, "samples per pixel")->check(CLI::Range(1u, 1u << 24));
-    render_cmd->add_option("--estimator", o.estimator, "estimator")->check(CLI::IsMember(kEstimators));
-    render_cmd->add_option("--light-select", o.light_select, "light selection")
+    render_cmd->add_option("--width", o.width, "image width")->capture_default_str()->check(CLI::Range(1, 16384));
+    render_cmd->add_option("--height", o.height, "image height")->capture_default_str()->check(CLI::Range(1, 16384));
+    render_cmd->add_option("--spp", o.spp, "samples per pixel")->capture_default_str()->check(CLI::Range(1u, 1u << 24));
+    render_cmd->add_option("--estimator", o.estimator, "estimator")->capture_default_str()->check(CLI::IsMember(kEstimators));
+    render_cmd->add_option("--light-select", o.light_select, "light selection")->capture_default_str()
         ->check(CLI::IsMember({"uniform", "power", "alias"}));
-    render_cmd->add_option("--sampler", o.sampler, "sample generator")
+    render_cmd->add_option("--sampler", o.sampler, "sample generator")->capture_default_str()
         ->check(CLI::IsMember({"independent", "stratified", "sobol"}));
-    render_cmd->add_option("--seed", o.seed, "random seed");
-    render_cmd->add_option("--sky", o.sky, "sky radiance R,G,B (ambient estimators)");
-    render_cmd->add_option("--ao-distance", o.ao_distance, "ambient occlusion distance, 0 = unbounded")
+    render_cmd->add_option("--seed", o.seed, "random seed")->capture_default_str();
+    render_cmd->add_option("--sky", o.sky, "sky radiance R,G,B (ambient estimators)")->capture_default_str();
+    render_cmd->add_option("--ao-distance", o.ao_distance, "ambient occlusion distance, 0 = unbounded")->capture_default_str()
         ->check(CLI::Range(0.0f, 3.4e38f));
     render_cmd->add_option("--camera", o.camera, "camera index in the scene")->check(CLI::Range(0, 1 << 30));
     render_cmd->add_option("--device", o.devices, "device index, cpu, gpu or all (repeatable)");
-    render_cmd->add_option("--batch", o.batch, "samples per pixel per launch (0 chooses)")
+    render_cmd->add_option("--batch", o.batch, "samples per pixel per launch (0 chooses)")->capture_default_str()
         ->check(CLI::Range(0u, 1u << 24));
     render_cmd->add_option("--stats", o.stats, "write statistics as JSON");
     render_cmd->add_option("--time-limit", o.time_limit, "stop after this many seconds")
         ->check(CLI::Range(0.0, 1e9));
-    render_cmd->add_option("--exposure", o.exposure, "PNG exposure in stops")->check(CLI::Range(-64.0f, 64.0f));
+    render_cmd->add_option("--exposure", o.exposure, "PNG exposure in stops")->capture_default_str()->check(CLI::Range(-64.0f, 64.0f));
     render_cmd->add_flag("--quiet", o.quiet, "no progress output");
 
     CLI::App* bench_cmd = app.add_subcommand("bench", "time ray queries on a scene");

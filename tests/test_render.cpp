@@ -1,0 +1,249 @@
+// The render pipeline against analytic images: a polygon light over a diffuse plane (exact
+// irradiance from Lambert's formula), emitters seen directly; batching independence.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
+
+#include "bvh/bvh.h"
+#include "device_support.h"
+#include "render/renderer.h"
+#include "scene_builders.h"
+
+using namespace mcrt;
+using namespace mcrt::test;
+
+namespace {
+
+// Camera at `eye` looking straight down −Y, image up = −Z.
+Camera looking_down(glm::vec3 eye, float yfov) {
+    Camera c;
+    c.camera_to_world = glm::mat4(glm::vec4(1, 0, 0, 0), glm::vec4(0, 0, -1, 0),
+                                  glm::vec4(0, 1, 0, 0), glm::vec4(eye, 1));
+    c.yfov = yfov;
+    return c;
+}
+
+// Irradiance at x (normal n) from a convex polygon of uniform radiance L wholly above x's
+// horizon: E = L/2 · |Σ Θ_i (Γ_i · n)| (Lambert 1760; Arvo 1995, "Applications of Irradiance
+// Tensors", eq. 1), Θ_i the angle the edge subtends, Γ_i the unit normal of its plane through x.
+double lambert_irradiance(const std::vector<glm::dvec3>& polygon, glm::dvec3 x, glm::dvec3 n,
+                          double L) {
+    double sum = 0;
+    for (size_t i = 0; i < polygon.size(); ++i) {
+        glm::dvec3 a = glm::normalize(polygon[i] - x);
+        glm::dvec3 b = glm::normalize(polygon[(i + 1) % polygon.size()] - x);
+        double theta = std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));
+        sum += theta * glm::dot(glm::normalize(glm::cross(a, b)), n);
+    }
+    return 0.5 * L * std::abs(sum);
+}
+
+struct Light {
+    std::vector<glm::dvec3> polygon;
+    glm::dvec3 Le;
+};
+
+// The plane y = 0 (albedo `albedo`) lit by `lights` (facing down), seen from above.
+struct PlaneScene {
+    Scene scene;
+    Camera camera = looking_down(glm::vec3(0, 3, 0), glm::radians(40.0f));
+    glm::dvec3 albedo{0.6, 0.5, 0.4};
+    std::vector<Light> lights;
+
+    PlaneScene() {
+        uint32_t floor = add_material(scene, albedo);
+        add_quad(scene, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, floor);
+        // A quad light (two triangles) and a small, brighter triangle light, both outside the
+        // camera's view and both facing −Y.
+        add_light({{0.8, 1, -0.25}, {1.3, 1, -0.25}, {1.3, 1, 0.25}, {0.8, 1, 0.25}}, {5, 4, 3});
+        add_light({{-1.4, 0.7, 0.2}, {-1.0, 0.7, 0.2}, {-1.2, 0.75, 0.5}}, {40, 30, 60});
+    }
+
+    void add_light(std::vector<glm::dvec3> polygon, glm::dvec3 Le) {
+        uint32_t m = add_material(scene, glm::vec3(0.0f), glm::vec3(Le));
+        if (polygon.size() == 4)
+            add_quad(scene, polygon[0], polygon[1], polygon[2], polygon[3], m);
+        else
+            add_triangle(scene, polygon[0], polygon[1], polygon[2], m);
+        lights.push_back({polygon, Le});
+    }
+
+    // Exact pixel values: the mean of albedo/π · E over the jittered pixel (box filter),
+    // integrated by an 8×8 midpoint rule over the jitter square.
+    std::vector<double> exact_image(int w, int h) const {
+        gpu::CameraGpu cam = make_gpu_camera(camera, w, h);
+        glm::dvec3 eye(cam.eye.x, cam.eye.y, cam.eye.z), fwd(cam.forward.x, cam.forward.y, cam.forward.z),
+            right(cam.right.x, cam.right.y, cam.right.z), up(cam.up.x, cam.up.y, cam.up.z);
+        std::vector<double> img(3 * size_t(w) * h);
+        const int q = 8;
+        for (int j = 0; j < h; ++j)
+            for (int i = 0; i < w; ++i)
+                for (int b = 0; b < q; ++b)
+                    for (int a = 0; a < q; ++a) {
+                        double x = 2.0 * (i + (a + 0.5) / q) / w - 1.0;
+                        double y = 1.0 - 2.0 * (j + (b + 0.5) / q) / h;
+                        glm::dvec3 d = fwd + x * right + y * up;
+                        glm::dvec3 p = eye + (-eye.y / d.y) * d;
+                        for (const Light& l : lights) {
+                            double E = lambert_irradiance(l.polygon, p, {0, 1, 0}, 1.0);
+                            for (int c = 0; c < 3; ++c)
+                                img[3 * (size_t(j) * w + i) + c] +=
+                                    albedo[c] / M_PI * l.Le[c] * E / (q * q);
+                        }
+                    }
+        return img;
+    }
+};
+
+RenderResult render_scene(const Scene& scene, const Camera& camera, RenderSettings settings) {
+    DeviceContext device = first_device();
+    Bvh bvh = build_bvh(scene);
+    GpuSceneData data = make_gpu_scene(scene, bvh, camera, settings.width, settings.height);
+    return render(device, data, settings);
+}
+
+}  // namespace
+
+TEST_CASE("Lambert's formula: a unit square straight above at height 1", "[render][analytic]") {
+    // Irradiance from a square of side 2a at height h centred above x, L = 1:
+    // E = 4 · (a/√(a²+h²)) · atan(a/√(a²+h²)) (PBRT 3rd ed. ex. / Howell's catalogue C-11).
+    double a = 0.5, h = 1.0, s = a / std::sqrt(a * a + h * h);
+    double expected = 4.0 * s * std::atan(s);
+    double E = lambert_irradiance({{-a, h, -a}, {a, h, -a}, {a, h, a}, {-a, h, a}}, {0, 0, 0},
+                                  {0, 1, 0}, 1.0);
+    CHECK(E == Approx(expected).epsilon(1e-12));
+}
+
+TEST_CASE("light-area is unbiased on a polygon light over a plane (Lambert's formula)",
+          "[render][analytic]") {
+    PlaneScene ps;
+    RenderSettings settings;
+    // Enough samples for a standard error under 0.5% of the mean: a 2% bias fails.
+    settings.width = 32;
+    settings.height = 32;
+    settings.spp = 256;
+    settings.seed = 3;
+    std::vector<double> exact = ps.exact_image(settings.width, settings.height);
+    for (LightSelect select : {LightSelect::Uniform, LightSelect::Power}) {
+        settings.light_select = select;
+        RenderResult r = render_scene(ps.scene, ps.camera, settings);
+        REQUIRE(r.nan_samples == 0);
+        const size_t n = size_t(settings.width) * settings.height;
+        int outliers = 0;
+        for (int c = 0; c < 3; ++c) {
+            // Image mean against the exact mean, within 4.5 standard errors of the estimate;
+            // the standard error from the per-pixel variance of the mean (pixels independent).
+            double sum = 0, sum_exact = 0, var_sum = 0;
+            for (size_t p = 0; p < n; ++p) {
+                double v = r.image.rgb[3 * p + c], e = exact[3 * p + c], var = r.image.variance[3 * p + c];
+                sum += v;
+                sum_exact += e;
+                var_sum += var;
+                if (std::abs(v - e) > 4.5 * std::sqrt(var)) ++outliers;
+            }
+            double se = std::sqrt(var_sum) / n;
+            INFO("light select " << int(select) << ", channel " << c << ": mean " << sum / n
+                                 << ", exact " << sum_exact / n << ", standard error " << se);
+            CHECK(se > 0);
+            CHECK(std::abs(sum - sum_exact) / n < 4.5 * se);
+            // The test has the power to see a bias of a percent or two.
+            CHECK(se < 0.005 * sum_exact / n);
+        }
+        // Each pixel within 4.5 of its own standard errors, but for the odd heavy tail.
+        CHECK(outliers <= 3);
+    }
+}
+
+TEST_CASE("power selection has lower variance than uniform when light powers differ",
+          "[render][analytic]") {
+    PlaneScene ps;
+    RenderSettings settings;
+    settings.width = 16;
+    settings.height = 16;
+    settings.spp = 64;
+    double var_sum[2] = {0, 0};
+    for (LightSelect select : {LightSelect::Uniform, LightSelect::Power}) {
+        settings.light_select = select;
+        RenderResult r = render_scene(ps.scene, ps.camera, settings);
+        for (float v : r.image.variance) var_sum[select == LightSelect::Power] += v;
+    }
+    INFO("summed variance: uniform " << var_sum[0] << ", power " << var_sum[1]);
+    CHECK(var_sum[1] < var_sum[0]);
+}
+
+TEST_CASE("an emitter seen directly shows Le on its emitting faces only", "[render]") {
+    RenderSettings settings;
+    settings.width = 8;
+    settings.height = 8;
+    settings.spp = 16;
+    const glm::vec3 Le(2.0f, 3.0f, 4.0f);
+    for (bool double_sided : {false, true})
+        for (bool from_front : {true, false}) {
+            Scene scene;
+            // A black emitter filling the view: nothing to reflect, so the pixel is exactly Le.
+            uint32_t m = add_material(scene, glm::vec3(0.0f), Le, double_sided);
+            float y = 0.0f;
+            if (from_front)  // faces +Y, toward the camera above
+                add_quad(scene, {-5, y, -5}, {-5, y, 5}, {5, y, 5}, {5, y, -5}, m);
+            else
+                add_quad(scene, {-5, y, -5}, {5, y, -5}, {5, y, 5}, {-5, y, 5}, m);
+            RenderResult r = render_scene(scene, looking_down({0, 2, 0}, 0.5f), settings);
+            glm::vec3 expected = (from_front || double_sided) ? Le : glm::vec3(0.0f);
+            for (size_t p = 0; p < r.image.rgb.size() / 3; ++p)
+                for (int c = 0; c < 3; ++c) {
+                    INFO("double sided " << double_sided << ", from front " << from_front);
+                    REQUIRE(r.image.rgb[3 * p + c] == Approx(expected[c]).epsilon(1e-6));
+                    REQUIRE(r.image.variance[3 * p + c] == Approx(0.0).margin(1e-9));
+                }
+        }
+}
+
+TEST_CASE("the image is bitwise identical for any batch size, and changes with the seed",
+          "[render][determinism]") {
+    PlaneScene ps;
+    RenderSettings settings;
+    settings.width = 16;
+    settings.height = 12;
+    settings.spp = 40;  // not a multiple of the chunk: the last chunk is short
+    settings.batch = 16;
+    RenderResult a = render_scene(ps.scene, ps.camera, settings);
+    settings.batch = 48;
+    RenderResult b = render_scene(ps.scene, ps.camera, settings);
+    settings.batch = 1;  // rounded up to one chunk
+    RenderResult c = render_scene(ps.scene, ps.camera, settings);
+    REQUIRE(a.devices[0].batches == 3);
+    REQUIRE(b.devices[0].batches == 1);
+    auto same_bits = [](const std::vector<float>& x, const std::vector<float>& y) {
+        return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(float)) == 0;
+    };
+    CHECK(same_bits(a.image.rgb, b.image.rgb));
+    CHECK(same_bits(a.image.variance, b.image.variance));
+    CHECK(same_bits(a.image.rgb, c.image.rgb));
+    CHECK(a.rays == b.rays);
+    settings.seed = 1;
+    RenderResult d = render_scene(ps.scene, ps.camera, settings);
+    CHECK(!same_bits(a.image.rgb, d.image.rgb));
+}
+
+TEST_CASE("a scene without lights renders black without error", "[render]") {
+    Scene scene;
+    add_quad(scene, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, add_material(scene, glm::vec3(0.8f)));
+    RenderSettings settings;
+    settings.width = 8;
+    settings.height = 8;
+    settings.spp = 4;
+    RenderResult r = render_scene(scene, looking_down({0, 2, 0}, 0.5f), settings);
+    for (float v : r.image.rgb) CHECK(v == 0.0f);
+    CHECK(r.nan_samples == 0);
+    CHECK(r.rays == 8u * 8u * 4u);  // camera rays only
+}
+
+TEST_CASE("batch sizes are whole chunks and never exceed the samples asked for", "[render]") {
+    CHECK(batch_samples_per_pixel(1, 512, 512, 16) == 16);
+    CHECK(batch_samples_per_pixel(17, 512, 512, 1024) == 32);
+    CHECK(batch_samples_per_pixel(0, 512, 512, 1024) == 16);    // 2^22 samples per launch
+    CHECK(batch_samples_per_pixel(0, 64, 64, 1024) == 1024);
+    CHECK(batch_samples_per_pixel(0, 64, 64, 20) == 32);        // covers spp in one launch
+    CHECK(batch_samples_per_pixel(0, 16384, 16384, 4) == 16);
+}
