@@ -79,4 +79,5 @@ kernel void shared_type_sizes(global uint* sizes) {
     sizes[2] = sizeof(Material);
     sizes[3] = sizeof(Light);
     sizes[4] = sizeof(CameraGpu);
+    sizes[5] = sizeof(AliasEntry);
 }

@@ -27,7 +27,8 @@ typedef struct {
 } BvhNode;
 
 /* Triangle in BVH leaf order, 48 bytes: world-space vertices, counter-clockwise seen from the
- * front. p0.w holds the material index as uint bits; p1.w holds the scene's triangle index. */
+ * front. p0.w holds the material index as uint bits; p1.w the scene's triangle index; p2.w the
+ * index of its Light plus one, 0 when it is not a light (uint bits). */
 typedef struct {
     float4 p0;
     float4 p1;
@@ -52,6 +53,15 @@ typedef struct {
     float4 Le;  /* .xyz emitted radiance, .w unused (selection pmfs live in the light CDF) */
 } Light;
 
+/* One entry of an alias table (Walker 1977; Vose 1991), 16 bytes: bucket i keeps i with
+ * probability prob, else gives alias; pmf is the probability of i itself. */
+typedef struct {
+    float prob;
+    uint alias;
+    float pmf;
+    uint pad0;
+} AliasEntry;
+
 /* Pinhole camera, 64 bytes. A ray through film point (x, y) in [-1, 1]² (x right, y up) has
  * direction forward + x·right + y·up, where right and up are already scaled by
  * tan(yfov/2)·aspect and tan(yfov/2) (DESIGN.md "Camera contract"). */
@@ -67,6 +77,7 @@ static_assert(sizeof(BvhNode) == 32 && alignof(BvhNode) == 16, "BvhNode layout")
 static_assert(sizeof(Triangle) == 48 && alignof(Triangle) == 16, "Triangle layout");
 static_assert(sizeof(Material) == 48 && alignof(Material) == 16, "Material layout");
 static_assert(sizeof(Light) == 64 && alignof(Light) == 16, "Light layout");
+static_assert(sizeof(AliasEntry) == 16 && alignof(AliasEntry) == 4, "AliasEntry layout");
 static_assert(sizeof(CameraGpu) == 64 && alignof(CameraGpu) == 16, "CameraGpu layout");
 }  // namespace mcrt::gpu
 #endif

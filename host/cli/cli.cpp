@@ -44,6 +44,19 @@ struct RenderOptions {
     bool quiet = false;
 };
 
+// CLI11's Range lets NaN through (both comparisons are false): reject non-finite values first.
+const CLI::Validator kFinite(
+    [](std::string& text) {
+        try {
+            size_t used = 0;
+            double v = std::stod(text, &used);
+            if (used == text.size() && std::isfinite(v)) return std::string();
+        } catch (const std::exception&) {
+        }
+        return "'" + text + "' is not a finite number";
+    },
+    "FINITE");
+
 const std::vector<std::string> kEstimators = {
     "hemisphere-uniform", "hemisphere-cosine", "light-area",      "light-solid-angle", "mis",
     "ambient-uniform",    "ambient-cosine",    "ambient-fibonacci"};
@@ -236,15 +249,15 @@ int run_cli(int argc, char** argv) {
     render_cmd->add_option("--seed", o.seed, "random seed")->capture_default_str();
     render_cmd->add_option("--sky", o.sky, "sky radiance R,G,B (ambient estimators)")->capture_default_str();
     render_cmd->add_option("--ao-distance", o.ao_distance, "ambient occlusion distance, 0 = unbounded")->capture_default_str()
-        ->check(CLI::Range(0.0f, 3.4e38f));
+        ->check(kFinite)->check(CLI::Range(0.0f, 3.4e38f));
     render_cmd->add_option("--camera", o.camera, "camera index in the scene")->check(CLI::Range(0, 1 << 30));
     render_cmd->add_option("--device", o.devices, "device index, cpu, gpu or all (repeatable)");
     render_cmd->add_option("--batch", o.batch, "samples per pixel per launch (0 chooses)")->capture_default_str()
         ->check(CLI::Range(0u, 1u << 24));
     render_cmd->add_option("--stats", o.stats, "write statistics as JSON");
     render_cmd->add_option("--time-limit", o.time_limit, "stop after this many seconds")
-        ->check(CLI::Range(0.0, 1e9));
-    render_cmd->add_option("--exposure", o.exposure, "PNG exposure in stops")->capture_default_str()->check(CLI::Range(-64.0f, 64.0f));
+        ->check(kFinite)->check(CLI::Range(0.0, 1e9));
+    render_cmd->add_option("--exposure", o.exposure, "PNG exposure in stops")->capture_default_str()->check(kFinite)->check(CLI::Range(-64.0f, 64.0f));
     render_cmd->add_flag("--quiet", o.quiet, "no progress output");
 
     CLI::App* bench_cmd = app.add_subcommand("bench", "time ray queries on a scene");

@@ -1,0 +1,451 @@
+// End-to-end tests of the mcrt executable: exit status, error lines, outputs
+// (DESIGN.md "Command line", "Outputs", exit status).
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "image/image.h"
+#include "process_support.h"
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+using namespace mcrt;
+using namespace mcrt::test;
+
+namespace {
+
+const std::string kCornell = std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf";
+
+// Small and fast: every render in this file uses these unless a test says otherwise.
+const std::vector<std::string> kSmall = {"--width", "32", "--height", "32", "--spp", "4", "--quiet"};
+
+std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
+    a.insert(a.end(), b.begin(), b.end());
+    return a;
+}
+
+std::string describe(const std::vector<std::string>& args) {
+    std::string text = "mcrt";
+    for (const std::string& a : args) text += " " + a;
+    return text;
+}
+
+// A fresh temporary directory per test: logs at its root, outputs in out/, so out/ holds
+// exactly what mcrt wrote.
+struct Sandbox {
+    TempDir tmp{"mcrt-cli"};
+    fs::path out_dir = tmp.path() / "out";
+
+    Sandbox() { fs::create_directory(out_dir); }
+
+    std::string out(const std::string& name) const { return (out_dir / name).string(); }
+
+    ProcessResult run(const std::vector<std::string>& args, double timeout_seconds = 120.0) const {
+        ProcessResult r = run_process(MCRT_EXE, args, tmp.path(), timeout_seconds);
+        INFO(describe(args) << "\n  exit " << r.exit_code << ", signal " << r.signal << ", "
+                            << r.seconds << " s\n  stdout: " << r.out << "\n  stderr: " << r.err);
+        CHECK_FALSE(r.timed_out);  // a hang
+        if (!r.timed_out) CHECK(r.signal == 0);  // a crash
+        return r;
+    }
+
+    std::vector<std::string> files() const {
+        std::vector<std::string> names;
+        for (const auto& entry : fs::recursive_directory_iterator(out_dir))
+            names.push_back(entry.path().lexically_relative(out_dir).string());
+        return names;
+    }
+
+    std::vector<std::string> temporary_files() const {
+        std::vector<std::string> names;
+        for (const std::string& name : files())
+            if (name.find(".tmp") != std::string::npos) names.push_back(name);
+        return names;
+    }
+};
+
+std::string joined(const std::vector<std::string>& names) {
+    std::string text;
+    for (const std::string& n : names) text += (text.empty() ? "" : ", ") + n;
+    return text;
+}
+
+// Exit 2 with exactly one error line, the first line of stderr.
+void check_usage_error(const ProcessResult& r) {
+    INFO("stderr: " << r.err);
+    CHECK(r.exit_code == 2);
+    CHECK(first_line(r.err).rfind("mcrt: error:", 0) == 0);
+    CHECK(lines_starting_with(r.err, "mcrt: error:").size() == 1);
+}
+
+bool all_finite(const std::vector<float>& v) {
+    for (float x : v)
+        if (!std::isfinite(x)) return false;
+    return true;
+}
+
+bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
+
+double mean(const std::vector<float>& v) {
+    double sum = 0;
+    for (float x : v) sum += x;
+    return v.empty() ? 0.0 : sum / double(v.size());
+}
+
+Image render_cornell(const Sandbox& box, const std::string& name, const std::vector<std::string>& extra) {
+    std::string exr = box.out(name);
+    ProcessResult r = box.run(concat({"render", kCornell, "--out", exr}, extra));
+    INFO(describe(extra) << "\nstderr: " << r.err);
+    REQUIRE(r.exit_code == 0);
+    return read_exr(exr);
+}
+
+// Every .gltf / .glb under `dir`, sorted.
+std::vector<fs::path> gltf_files(const fs::path& dir, bool recursive) {
+    std::vector<fs::path> found;
+    auto take = [&](const fs::directory_entry& e) {
+        std::string ext = e.path().extension().string();
+        if (e.is_regular_file() && (ext == ".gltf" || ext == ".glb")) found.push_back(e.path());
+    };
+    if (recursive)
+        for (const auto& e : fs::recursive_directory_iterator(dir)) take(e);
+    else
+        for (const auto& e : fs::directory_iterator(dir)) take(e);
+    std::sort(found.begin(), found.end());
+    return found;
+}
+
+// Renders `scene`: either success (exit 0, an EXR with finite pixels, no temporary left) or
+// a clean rejection (exit 2, one error line naming the file, nothing written). Returns a
+// one-line summary.
+std::string check_robust_render(const fs::path& scene) {
+    Sandbox box;
+    std::string exr = box.out("r.exr");
+    ProcessResult r = box.run(concat({"render", scene.string(), "--out", exr}, kSmall));
+    std::vector<std::string> errors = lines_starting_with(r.err, "mcrt: error:");
+    std::vector<std::string> warnings = lines_starting_with(r.err, "mcrt: warning:");
+    INFO(scene.string() << "\n  exit " << r.exit_code << "\n  stderr: " << r.err);
+    CHECK((r.exit_code == 0 || r.exit_code == 2));
+    if (r.exit_code == 0) {
+        CHECK(errors.empty());
+        REQUIRE(fs::exists(exr));
+        Image image = read_exr(exr);
+        CHECK(image.width == 32);
+        CHECK(image.height == 32);
+        CHECK(all_finite(image.rgb));
+        CHECK(all_finite(image.variance));
+        CHECK(box.temporary_files().empty());
+        return "ok (" + std::to_string(warnings.size()) + " warning(s), mean " +
+               std::to_string(mean(image.rgb)) + ")";
+    }
+    CHECK(errors.size() == 1);
+    CHECK(first_line(r.err).rfind("mcrt: error:", 0) == 0);
+    if (!errors.empty()) CHECK(errors.front().find(scene.filename().string()) != std::string::npos);
+    INFO("left behind: " << joined(box.files()));
+    CHECK(box.files().empty());
+    if (errors.empty()) return "rejected without an error line";
+    std::string message = errors.front();
+    size_t named = message.find(scene.filename().string() + ": ");
+    return "rejected: " + (named == std::string::npos ? message
+                                                       : message.substr(named + scene.filename().string().size() + 2));
+}
+
+}  // namespace
+
+TEST_CASE("mcrt devices lists at least one device", "[cli]") {
+    Sandbox box;
+    ProcessResult r = box.run({"devices"});
+    INFO("stdout: " << r.out << "\nstderr: " << r.err);
+    CHECK(r.exit_code == 0);
+    CHECK_FALSE(lines_starting_with(r.out, "0: ").empty());
+}
+
+TEST_CASE("mcrt render writes the EXR, PNG and stats it is asked for", "[cli]") {
+    Sandbox box;
+    const int width = 32, height = 24, spp = 4;
+    std::string exr = box.out("c.exr"), png = box.out("c.png"), stats = box.out("s.json");
+    ProcessResult r = box.run({"render", kCornell, "--out", exr, "--png", png, "--stats", stats, "--width",
+                               std::to_string(width), "--height", std::to_string(height), "--spp",
+                               std::to_string(spp), "--quiet"});
+    INFO("stderr: " << r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(lines_starting_with(r.err, "mcrt: error:").empty());
+
+    SECTION("EXR") {
+        REQUIRE(fs::exists(exr));
+        Image image = read_exr(exr);
+        CHECK(image.width == width);
+        CHECK(image.height == height);
+        CHECK(image.spp == spp);
+        REQUIRE(image.rgb.size() == size_t(3 * width * height));
+        REQUIRE(image.variance.size() == image.rgb.size());
+        bool finite_non_negative = true;
+        for (float x : image.rgb) finite_non_negative = finite_non_negative && std::isfinite(x) && x >= 0;
+        CHECK(finite_non_negative);
+        CHECK(mean(image.rgb) > 0);
+        bool variance_ok = true, variance_nonzero = false;
+        for (float v : image.variance) {
+            variance_ok = variance_ok && std::isfinite(v) && v >= 0;
+            variance_nonzero = variance_nonzero || v > 0;
+        }
+        CHECK(variance_ok);
+        CHECK(variance_nonzero);
+    }
+    SECTION("PNG") {
+        REQUIRE(fs::exists(png));
+        CHECK(fs::file_size(png) > 8);
+    }
+    SECTION("stats JSON") {
+        REQUIRE(fs::exists(stats));
+        nlohmann::json j;
+        REQUIRE_NOTHROW(j = nlohmann::json::parse(read_whole_file(stats)));
+        for (const char* key : {"scene", "width", "height", "spp", "estimator", "light_select", "sampler", "seed",
+                                "devices", "seconds_total", "seconds_render", "samples_per_second",
+                                "rays_per_second", "nan_samples"}) {
+            INFO("key " << key);
+            CHECK(j.contains(key));
+        }
+        CHECK(j.value("width", -1) == width);
+        CHECK(j.value("height", -1) == height);
+        CHECK(j.value("spp", -1) == spp);
+        CHECK(j.value("estimator", std::string()) == "light-area");
+        CHECK(j.value("light_select", std::string()) == "power");
+        CHECK(j.value("sampler", std::string()) == "independent");
+        CHECK(j.value("seed", -1) == 0);
+        CHECK(j.value("nan_samples", -1) == 0);
+        REQUIRE(j.contains("devices"));
+        REQUIRE(j["devices"].is_array());
+        REQUIRE(j["devices"].size() >= 1);
+        CHECK(j["devices"][0].contains("name"));
+        REQUIRE(j["devices"][0].contains("samples"));
+        CHECK(j["devices"][0]["samples"].get<int64_t>() == int64_t(width) * height * spp);
+        CHECK(j.value("seconds_total", -1.0) >= j.value("seconds_render", -1.0));
+        CHECK(j.value("samples_per_second", -1.0) > 0);
+        CHECK(j.value("rays_per_second", -1.0) > 0);
+    }
+    SECTION("no temporary files remain") {
+        INFO("files: " << joined(box.files()));
+        CHECK(box.temporary_files().empty());
+        CHECK(box.files().size() == 3);
+    }
+}
+
+TEST_CASE("bad usage exits 2 with one error line and writes nothing", "[cli]") {
+    struct Case {
+        std::string name;
+        std::vector<std::string> args;  // "@D" is replaced by the output directory
+        std::vector<std::string> mentions;
+    };
+    const std::vector<std::string> out = {"--out", "@D/x.exr"};
+    const std::vector<std::string> cases_scene = {"render", kCornell};
+    auto render = [&](std::vector<std::string> extra) { return concat(concat(cases_scene, out), extra); };
+    const std::vector<Case> cases = {
+        {"unknown option", render({"--bogus"}), {"--bogus"}},
+        {"unknown estimator", render({"--estimator", "nope"}),
+         {"nope", "hemisphere-uniform", "hemisphere-cosine", "light-area", "light-solid-angle", "mis"}},
+        {"width 0", render({"--width", "0"}), {"--width"}},
+        {"width -3", render({"--width", "-3"}), {"--width"}},
+        {"spp 0", render({"--spp", "0"}), {"--spp"}},
+        {"spp abc", render({"--spp", "abc"}), {"--spp"}},
+        {"missing --out", concat(cases_scene, {"--quiet"}), {"--out"}},
+        {"no subcommand", {}, {}},
+        {"--out into a missing directory", concat(cases_scene, {"--out", "@D/missing/x.exr"}),
+         {"--out", "@D/missing"}},
+        {"--png into a missing directory", render({"--png", "@D/missing/x.png"}), {"--png", "@D/missing"}},
+        {"missing scene file", {"render", "@D/no such scene.gltf", "--out", "@D/x.exr"}, {"no such scene.gltf"}},
+        {"estimator mis", render({"--estimator", "mis"}), {"mis", "not yet supported"}},
+        {"light-select alias", render({"--light-select", "alias"}), {"alias", "not yet supported"}},
+        {"sampler sobol", render({"--sampler", "sobol"}), {"sobol", "not yet supported"}},
+        {"time-limit", render({"--time-limit", "1"}), {"--time-limit", "not yet supported"}},
+        {"camera out of range", render({"--camera", "5"}), {"--camera"}},
+        {"device 99", render({"--device", "99"}), {"--device", "99"}},
+        {"device bogus", render({"--device", "bogus"}), {"--device", "bogus"}},
+        {"sky -1", render({"--sky", "-1"}), {"--sky"}},
+        {"sky with two values", render({"--sky", "1,2"}), {"--sky"}},
+    };
+    for (const Case& c : cases) {
+        Sandbox box;
+        auto expand = [&](std::string s) {
+            for (size_t at; (at = s.find("@D")) != std::string::npos;) s.replace(at, 2, box.out_dir.string());
+            return s;
+        };
+        std::vector<std::string> args;
+        for (const std::string& a : c.args) args.push_back(expand(a));
+        if (!args.empty() && args[0] == "render") args = concat(args, {"--width", "8", "--height", "8", "--quiet"});
+        ProcessResult r = box.run(args);
+        INFO("case: " << c.name << "\n  " << describe(args) << "\n  stderr: " << r.err);
+        check_usage_error(r);
+        for (const std::string& m : c.mentions) {
+            INFO("the error should mention " << expand(m));
+            CHECK(r.err.find(expand(m)) != std::string::npos);
+        }
+        INFO("left behind: " << joined(box.files()));
+        CHECK(box.files().empty());
+    }
+}
+
+TEST_CASE("a rejected render leaves an existing output untouched", "[cli]") {
+    Sandbox box;
+    std::string exr = box.out("x.exr");
+    std::ofstream(exr) << "keep";
+    ProcessResult r = box.run(concat({"render", std::string(MCRT_TEST_DATA) + "/nan_position.gltf", "--out", exr}, kSmall));
+    check_usage_error(r);
+    CHECK(read_whole_file(exr) == "keep");
+    INFO("files: " << joined(box.files()));
+    CHECK(box.files().size() == 1);
+}
+
+TEST_CASE("output paths with spaces reach mcrt intact", "[cli]") {
+    Sandbox box;
+    fs::create_directory(box.out_dir / "with space");
+    std::string exr = box.out("with space/c d.exr"), png = box.out("with space/c d.png");
+    ProcessResult r = box.run(concat({"render", kCornell, "--out", exr, "--png", png}, kSmall));
+    INFO("stderr: " << r.err);
+    CHECK(r.exit_code == 0);
+    CHECK(fs::exists(exr));
+    CHECK(fs::exists(png));
+}
+
+// DESIGN.md: "a value out of range" exits 2. CLI11's Range check compares with < and >, which
+// NaN passes; cli.cpp adds a finiteness check, tested here for each floating-point option.
+TEST_CASE("NaN option values are rejected", "[cli]") {
+    for (const char* option : {"--exposure", "--ao-distance", "--time-limit"}) {
+        Sandbox box;
+        ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("x.exr"), "--png", box.out("x.png"),
+                                          option, "nan"},
+                                         kSmall));
+        INFO(option << " nan\n  stderr: " << r.err);
+        check_usage_error(r);
+        CHECK(r.err.find(option) != std::string::npos);
+        INFO("left behind: " << joined(box.files()));
+        CHECK(box.files().empty());
+    }
+}
+
+TEST_CASE("broken and valid glTF files in tests/data render or are rejected cleanly", "[cli][robustness]") {
+    std::vector<fs::path> files = gltf_files(MCRT_TEST_DATA, false);
+    REQUIRE_FALSE(files.empty());
+    std::string summary;
+    for (const fs::path& f : files) summary += "\n  " + f.filename().string() + ": " + check_robust_render(f);
+    WARN("tests/data:" << summary);
+}
+
+TEST_CASE("shared robustness and Khronos scenes render or are rejected cleanly", "[cli][robustness][shared]") {
+    fs::path shared = MCRT_SHARED_SCENES;
+    if (!fs::is_directory(shared / "robustness") && !fs::is_directory(shared / "khronos"))
+        skip_test("shared scenes not present: " + shared.string());
+    std::vector<fs::path> files;
+    for (const char* sub : {"robustness", "khronos"})
+        if (fs::is_directory(shared / sub))
+            for (const fs::path& f : gltf_files(shared / sub, true)) files.push_back(f);
+    REQUIRE_FALSE(files.empty());
+    std::string summary;
+    for (const fs::path& f : files)
+        summary += "\n  " + f.lexically_relative(shared).string() + ": " + check_robust_render(f);
+    WARN("shared scenes:" << summary);
+}
+
+TEST_CASE("mcrt render --help lists the options and their defaults", "[cli]") {
+    Sandbox box;
+    ProcessResult r = box.run({"render", "--help"});
+    INFO("stdout: " << r.out << "\nstderr: " << r.err);
+    CHECK(r.exit_code == 0);
+    for (const char* text : {"--estimator", "--out", "--spp", "512", "16", "light-area", "power", "independent"}) {
+        INFO("help should mention " << text);
+        CHECK(r.out.find(text) != std::string::npos);
+    }
+    CHECK(box.files().empty());
+}
+
+TEST_CASE("renders are deterministic end to end", "[cli][determinism]") {
+    Sandbox box;
+    SECTION("the same render twice") {
+        Image a = render_cornell(box, "a.exr", kSmall);
+        Image b = render_cornell(box, "b.exr", kSmall);
+        CHECK(same_bits(a.rgb, b.rgb));
+        CHECK(same_bits(a.variance, b.variance));
+    }
+    SECTION("batch size does not change the image") {
+        const std::vector<std::string> common = {"--width", "32", "--height", "32", "--spp", "40", "--quiet"};
+        Image a = render_cornell(box, "a.exr", concat(common, {"--batch", "16"}));
+        Image b = render_cornell(box, "b.exr", concat(common, {"--batch", "48"}));
+        Image c = render_cornell(box, "c.exr", concat(common, {"--batch", "1"}));
+        CHECK(a.spp == 40);
+        CHECK(b.spp == 40);
+        CHECK(same_bits(a.rgb, b.rgb));
+        CHECK(same_bits(a.variance, b.variance));
+        CHECK(same_bits(a.rgb, c.rgb));
+        CHECK(same_bits(a.variance, c.variance));
+    }
+    SECTION("the seed changes the image") {
+        Image a = render_cornell(box, "a.exr", concat(kSmall, {"--seed", "1"}));
+        Image b = render_cornell(box, "b.exr", concat(kSmall, {"--seed", "2"}));
+        CHECK_FALSE(same_bits(a.rgb, b.rgb));
+    }
+}
+
+TEST_CASE("a scene without emitters renders black with a warning", "[cli][shared]") {
+    std::string scene = shared_scene("khronos/Box/Box.gltf");
+    Sandbox box;
+    std::string exr = box.out("b.exr");
+    ProcessResult r = box.run(concat({"render", scene, "--out", exr}, kSmall));
+    INFO("stderr: " << r.err);
+    REQUIRE(r.exit_code == 0);
+    std::vector<std::string> warnings = lines_starting_with(r.err, "mcrt: warning:");
+    bool mentions_emissive = false;
+    for (const std::string& w : warnings) mentions_emissive = mentions_emissive || w.find("emissive") != std::string::npos;
+    CHECK(mentions_emissive);
+    Image image = read_exr(exr);
+    bool black = true;
+    for (float x : image.rgb) black = black && x == 0.0f;
+    CHECK(black);
+    CHECK(box.temporary_files().empty());
+}
+
+TEST_CASE("a scene without a camera renders with the bench camera", "[cli][shared]") {
+    SECTION("khronos Box (no camera, no emitter)") {
+        std::string scene = shared_scene("khronos/Box/Box.gltf");
+        nlohmann::json gltf = nlohmann::json::parse(read_whole_file(scene));
+        REQUIRE((!gltf.contains("cameras") || gltf["cameras"].empty()));
+        Sandbox box;
+        ProcessResult r = box.run(concat({"render", scene, "--out", box.out("b.exr")}, kSmall));
+        INFO("stderr: " << r.err);
+        CHECK(r.exit_code == 0);
+        CHECK(fs::exists(box.out("b.exr")));
+    }
+    SECTION("stanford bunny .glb") {
+        std::string scene = shared_scene("stanford/bunny_zipper.glb");
+        Sandbox box;
+        ProcessResult r = box.run(concat({"render", scene, "--out", box.out("b.exr")}, kSmall));
+        INFO("stderr: " << r.err);
+        CHECK(r.exit_code == 0);
+        CHECK(fs::exists(box.out("b.exr")));
+    }
+    SECTION("an emissive floor seen by the bench camera") {
+        // A 40×40 double-sided emitter (L_e = 1) in the plane y = -1.05, no camera: the bench
+        // camera looks down at its centre from c + diag·(0.35, 0.30, 0.55), 45° field of view,
+        // so the centre pixel sees L_e (light from a coplanar emitter adds nothing) while the
+        // top row looks past the floor's far edge into black.
+        std::string scene = shared_scene("cornell/fazil47_cornell-box/emissive_floor.glb");
+        Sandbox box;
+        std::string exr = box.out("f.exr");
+        ProcessResult r = box.run(concat({"render", scene, "--out", exr}, kSmall));
+        INFO("stderr: " << r.err);
+        REQUIRE(r.exit_code == 0);
+        Image image = read_exr(exr);
+        REQUIRE(image.width == 32);
+        auto red = [&](int i, int j) { return image.rgb[3 * (size_t(j) * image.width + i)]; };
+        CHECK(red(16, 16) == Approx(1.0f).epsilon(1e-3));
+        CHECK(red(0, 0) == 0.0f);
+        CHECK(red(31, 0) == 0.0f);
+    }
+}
