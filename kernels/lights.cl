@@ -1,64 +1,77 @@
-/* Choosing an emissive triangle and a point on it. */
+/* Choosing an emissive triangle and a point or direction on it. */
 #ifndef MCRT_LIGHTS_CL
 #define MCRT_LIGHTS_CL
 
+#include "discrete.cl"
 #include "sampling.cl"
 
-/* Lights and their selection distribution. light_cdf has light_count + 1 entries, cdf[0] = 0,
- * cdf[light_count] = 1; zero-power lights have empty intervals and are never selected. */
+/* Lights and their selection distributions: light_cdf (light_count + 1 entries) and alias
+ * (light_count entries) both follow emitted power; zero-power lights are never selected. */
 typedef struct {
     global const Light* lights;
     global const float* light_cdf;
+    global const AliasEntry* alias;
     uint light_count;
 } LightSet;
 
-typedef struct {
-    uint index;
-    float pmf;
-} LightChoice;
-
-/* Selects a light with probability pmf; light_count must be > 0. */
-inline LightChoice select_light(const LightSet* ls, float u) {
-    LightChoice c;
+/* Selects a light (-D LIGHT_SELECT_UNIFORM, LIGHT_SELECT_POWER or LIGHT_SELECT_ALIAS);
+ * light_count must be > 0. */
+inline DiscreteSample select_light(const LightSet* ls, float u) {
 #if defined(LIGHT_SELECT_UNIFORM)
+    DiscreteSample c;
     c.index = min((uint)(u * (float)ls->light_count), ls->light_count - 1u);
     c.pmf = 1.0f / (float)ls->light_count;
-#else
-    /* CDF inversion by binary search (PBRT 3rd ed. 13.3.1): the last i with cdf[i] <= u, whose
-     * interval [cdf[i], cdf[i+1]) contains u and so is not empty. */
-    uint lo = 0u, hi = ls->light_count;
-    while (hi - lo > 1u) {
-        uint mid = (lo + hi) / 2u;
-        if (ls->light_cdf[mid] <= u)
-            lo = mid;
-        else
-            hi = mid;
-    }
-    c.index = lo;
-    c.pmf = ls->light_cdf[lo + 1u] - ls->light_cdf[lo];
-#endif
     return c;
+#elif defined(LIGHT_SELECT_ALIAS)
+    return sample_discrete_alias(ls->alias, ls->light_count, u);
+#else
+    return sample_discrete_cdf(ls->light_cdf, ls->light_count, u);
+#endif
+}
+
+/* Probability that select_light returns light i. */
+inline float light_pmf(const LightSet* ls, uint i) {
+#if defined(LIGHT_SELECT_UNIFORM)
+    return 1.0f / (float)ls->light_count;
+#elif defined(LIGHT_SELECT_ALIAS)
+    return discrete_alias_pmf(ls->alias, i);
+#else
+    return discrete_cdf_pmf(ls->light_cdf, i);
+#endif
+}
+
+inline bool light_double_sided(const Light* light) {
+    return (as_uint(light->p1.w) & MATERIAL_DOUBLE_SIDED) != 0u;
+}
+
+inline float light_area(const Light* light) { return light->p0.w; }
+
+/* Unit front-face normal (counter-clockwise winding). */
+inline float3 light_normal(const Light* light) {
+    return normalize(cross(light->p1.xyz - light->p0.xyz, light->p2.xyz - light->p0.xyz));
 }
 
 typedef struct {
     float3 p;  /* point on the light */
-    float3 n;  /* unit front-face normal (counter-clockwise winding) */
     float pdf_a;
 } LightPoint;
 
 /* Uniform point on the light's triangle; density with respect to area. */
 inline LightPoint sample_light_point(const Light* light, float2 u) {
     float2 b = sample_triangle_uniform(u);
-    float3 p0 = light->p0.xyz, e1 = light->p1.xyz - p0, e2 = light->p2.xyz - p0;
+    float3 p0 = light->p0.xyz;
     LightPoint lp;
-    lp.p = p0 + b.x * e1 + b.y * e2;
-    lp.n = normalize(cross(e1, e2));
-    lp.pdf_a = sample_triangle_uniform_pdf_a(light->p0.w);
+    lp.p = p0 + b.x * (light->p1.xyz - p0) + b.y * (light->p2.xyz - p0);
+    lp.pdf_a = sample_triangle_uniform_pdf_a(light_area(light));
     return lp;
 }
 
-inline bool light_double_sided(const Light* light) {
-    return (as_uint(light->p1.w) & MATERIAL_DOUBLE_SIDED) != 0u;
+/* Cosine at the light between its normal and the direction wi from the receiver toward it:
+ * positive when the receiver sees an emitting face, else 0. */
+inline float light_emitting_cosine(const Light* light, float3 n_light, float3 wi) {
+    float c = -dot(n_light, wi);
+    if (light_double_sided(light)) c = fabs(c);
+    return max(c, 0.0f);
 }
 
 #endif

@@ -4,13 +4,14 @@
 #include "estimators.cl"
 
 /* One work-item per pixel sample of a batch. Work-item g renders sample
- * sample_begin + g % batch_samples of pixel g / batch_samples (samples of a pixel adjacent) and
- * writes samples[g] = (radiance, number of rays traced). */
+ * sample_begin + g % batch_samples (of spp in all) of pixel g / batch_samples (samples of a
+ * pixel adjacent) and writes samples[g] = (radiance, number of rays traced). */
 kernel void render(global const BvhNode* nodes, global const Triangle* triangles,
                    global const Material* materials, global const Light* lights,
-                   global const float* light_cdf, uint light_count,
-                   global const CameraGpu* camera, uint width, uint height, uint seed,
-                   uint sample_begin, uint batch_samples, global float4* samples) {
+                   global const float* light_cdf, global const AliasEntry* light_alias,
+                   uint light_count, global const CameraGpu* camera, uint width, uint height,
+                   uint seed, uint spp, float4 sky, float ao_distance, uint sample_begin,
+                   uint batch_samples, global float4* samples) {
     size_t g = get_global_id(0);
     uint pixel = (uint)(g / batch_samples);
     if (pixel >= width * height) return;
@@ -18,6 +19,7 @@ kernel void render(global const BvhNode* nodes, global const Triangle* triangles
     SampleStream stream;
     stream.pixel = pixel;
     stream.sample = sample_begin + (uint)(g % batch_samples);
+    stream.sample_count = spp;
     stream.seed = seed;
 
     SceneView scene;
@@ -26,13 +28,18 @@ kernel void render(global const BvhNode* nodes, global const Triangle* triangles
     scene.materials = materials;
     scene.lights.lights = lights;
     scene.lights.light_cdf = light_cdf;
+    scene.lights.alias = light_alias;
     scene.lights.light_count = light_count;
+
+    Environment env;
+    env.sky = sky.xyz;
+    env.ao_distance = ao_distance;
 
     float3 dir = camera_direction(camera, pixel % width, pixel / width,
                                   sample_2d(&stream, DIM_PIXEL_JITTER), width, height);
     Ray r = make_ray(camera->eye.xyz, dir);
     uint rays = 0u;
-    float3 L = radiance(&scene, &r, &stream, &rays);
+    float3 L = radiance(&scene, &r, &stream, &env, &rays);
     samples[g] = (float4)(L, (float)rays);
 }
 

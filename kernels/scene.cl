@@ -17,6 +17,7 @@ typedef struct {
     float3 p;      /* from barycentrics, not from o + t·d (Wächter & Binder 2019) */
     float3 n;      /* unit geometric normal, flipped toward the incoming ray */
     bool front;    /* the ray arrived on the counter-clockwise (front) side */
+    uint light;    /* index of its Light plus one; 0 when it is not a light */
     Material material;
 } SurfacePoint;
 
@@ -28,6 +29,7 @@ inline SurfacePoint surface_point(const SceneView* scene, const Ray* r, const Hi
     float3 ng = normalize(cross(e1, e2));
     sp.front = dot(ng, r->dir) < 0.0f;
     sp.n = sp.front ? ng : -ng;
+    sp.light = as_uint(tri.p2.w);
     sp.material = scene->materials[as_uint(tri.p0.w)];
     return sp;
 }

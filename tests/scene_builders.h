@@ -30,9 +30,9 @@ inline void add_quad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 
     add_triangle(s, a, c, d, material);
 }
 
-// Closed latitude–longitude sphere, outward-facing: every ray from inside must hit it.
+// Closed latitude–longitude sphere, facing outward (or inward): every ray from inside hits it.
 inline void add_sphere(Scene& s, glm::vec3 centre, float radius, int slices, int stacks,
-                       uint32_t material) {
+                       uint32_t material, bool inward = false) {
     auto vertex = [&](int i, int j) {
         // Poles are one shared point each (sin π is not exactly 0 in float).
         if (j == 0 || j == stacks) return centre + glm::vec3(0.0f, j == 0 ? radius : -radius, 0.0f);
@@ -45,8 +45,9 @@ inline void add_sphere(Scene& s, glm::vec3 centre, float radius, int slices, int
         for (int i = 0; i < slices; ++i) {
             glm::vec3 a = vertex(i, j), b = vertex(i + 1, j), c = vertex(i + 1, j + 1),
                       d = vertex(i, j + 1);
-            if (j > 0) add_triangle(s, a, b, c, material);
-            if (j < stacks - 1) add_triangle(s, a, c, d, material);
+            // Pole rows have one triangle per slice; inward reverses the winding.
+            if (j > 0) add_triangle(s, a, inward ? c : b, inward ? b : c, material);
+            if (j < stacks - 1) add_triangle(s, a, inward ? d : c, inward ? c : d, material);
         }
 }
 

@@ -8,93 +8,13 @@
 #include "bvh/bvh.h"
 #include "device_support.h"
 #include "render/renderer.h"
+#include "analytic_scenes.h"
 #include "scene_builders.h"
 
 using namespace mcrt;
 using namespace mcrt::test;
 
 namespace {
-
-// Camera at `eye` looking straight down −Y, image up = −Z.
-Camera looking_down(glm::vec3 eye, float yfov) {
-    Camera c;
-    c.camera_to_world = glm::mat4(glm::vec4(1, 0, 0, 0), glm::vec4(0, 0, -1, 0),
-                                  glm::vec4(0, 1, 0, 0), glm::vec4(eye, 1));
-    c.yfov = yfov;
-    return c;
-}
-
-// Irradiance at x (normal n) from a convex polygon of uniform radiance L wholly above x's
-// horizon: E = L/2 · |Σ Θ_i (Γ_i · n)| (Lambert 1760; Arvo 1995, "Applications of Irradiance
-// Tensors", eq. 1), Θ_i the angle the edge subtends, Γ_i the unit normal of its plane through x.
-double lambert_irradiance(const std::vector<glm::dvec3>& polygon, glm::dvec3 x, glm::dvec3 n,
-                          double L) {
-    double sum = 0;
-    for (size_t i = 0; i < polygon.size(); ++i) {
-        glm::dvec3 a = glm::normalize(polygon[i] - x);
-        glm::dvec3 b = glm::normalize(polygon[(i + 1) % polygon.size()] - x);
-        double theta = std::acos(std::clamp(glm::dot(a, b), -1.0, 1.0));
-        sum += theta * glm::dot(glm::normalize(glm::cross(a, b)), n);
-    }
-    return 0.5 * L * std::abs(sum);
-}
-
-struct Light {
-    std::vector<glm::dvec3> polygon;
-    glm::dvec3 Le;
-};
-
-// The plane y = 0 (albedo `albedo`) lit by `lights` (facing down), seen from above.
-struct PlaneScene {
-    Scene scene;
-    Camera camera = looking_down(glm::vec3(0, 3, 0), glm::radians(40.0f));
-    glm::dvec3 albedo{0.6, 0.5, 0.4};
-    std::vector<Light> lights;
-
-    PlaneScene() {
-        uint32_t floor = add_material(scene, albedo);
-        add_quad(scene, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, floor);
-        // A quad light (two triangles) and a small, brighter triangle light, both outside the
-        // camera's view and both facing −Y.
-        add_light({{0.8, 1, -0.25}, {1.3, 1, -0.25}, {1.3, 1, 0.25}, {0.8, 1, 0.25}}, {5, 4, 3});
-        add_light({{-1.4, 0.7, 0.2}, {-1.0, 0.7, 0.2}, {-1.2, 0.75, 0.5}}, {40, 30, 60});
-    }
-
-    void add_light(std::vector<glm::dvec3> polygon, glm::dvec3 Le) {
-        uint32_t m = add_material(scene, glm::vec3(0.0f), glm::vec3(Le));
-        if (polygon.size() == 4)
-            add_quad(scene, polygon[0], polygon[1], polygon[2], polygon[3], m);
-        else
-            add_triangle(scene, polygon[0], polygon[1], polygon[2], m);
-        lights.push_back({polygon, Le});
-    }
-
-    // Exact pixel values: the mean of albedo/π · E over the jittered pixel (box filter),
-    // integrated by an 8×8 midpoint rule over the jitter square.
-    std::vector<double> exact_image(int w, int h) const {
-        gpu::CameraGpu cam = make_gpu_camera(camera, w, h);
-        glm::dvec3 eye(cam.eye.x, cam.eye.y, cam.eye.z), fwd(cam.forward.x, cam.forward.y, cam.forward.z),
-            right(cam.right.x, cam.right.y, cam.right.z), up(cam.up.x, cam.up.y, cam.up.z);
-        std::vector<double> img(3 * size_t(w) * h);
-        const int q = 8;
-        for (int j = 0; j < h; ++j)
-            for (int i = 0; i < w; ++i)
-                for (int b = 0; b < q; ++b)
-                    for (int a = 0; a < q; ++a) {
-                        double x = 2.0 * (i + (a + 0.5) / q) / w - 1.0;
-                        double y = 1.0 - 2.0 * (j + (b + 0.5) / q) / h;
-                        glm::dvec3 d = fwd + x * right + y * up;
-                        glm::dvec3 p = eye + (-eye.y / d.y) * d;
-                        for (const Light& l : lights) {
-                            double E = lambert_irradiance(l.polygon, p, {0, 1, 0}, 1.0);
-                            for (int c = 0; c < 3; ++c)
-                                img[3 * (size_t(j) * w + i) + c] +=
-                                    albedo[c] / M_PI * l.Le[c] * E / (q * q);
-                        }
-                    }
-        return img;
-    }
-};
 
 RenderResult render_scene(const Scene& scene, const Camera& camera, RenderSettings settings) {
     DeviceContext device = first_device();

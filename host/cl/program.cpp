@@ -3,6 +3,8 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <mutex>
+#include <tuple>
 #include <set>
 #include <sstream>
 
@@ -70,6 +72,23 @@ cl::Program build_program(const cl::Context& context, const cl::Device& device,
         throw RuntimeError("kernel build failed on '" + name + "' (" + cl_error_name(status) +
                            ", options '" + options + "'):\n" + log);
     }
+    return program;
+}
+
+cl::Program cached_program(const DeviceContext& device, const std::string& file,
+                           const std::string& options) {
+    // Keyed by the context handle: the cached program holds a reference to its context, so the
+    // handle cannot be freed and reused while the entry exists.
+    using Key = std::tuple<cl_context, cl_device_id, std::string, std::string>;
+    static std::mutex mutex;
+    static std::map<Key, cl::Program> programs;
+    Key key{device.context(), device.info.device(), file, options};
+    std::lock_guard<std::mutex> lock(mutex);
+    auto it = programs.find(key);
+    if (it != programs.end()) return it->second;
+    cl::Program program =
+        build_program(device.context, device.info.device, kernel_source(file), options);
+    programs.emplace(key, program);
     return program;
 }
 

@@ -5,6 +5,8 @@
 
 #include <CL/opencl.hpp>
 
+#include "cl/device.h"
+
 namespace mcrt {
 
 // Source of kernels/<file> with every #include "..." expanded once (include guards are not
@@ -17,6 +19,12 @@ std::string kernel_source(const std::string& file);
 // RuntimeError carrying the device name and the build log.
 cl::Program build_program(const cl::Context& context, const cl::Device& device,
                           const std::string& source, const std::string& options);
+
+// build_program(kernel_source(file), options) for the device, built once per process and kept:
+// every specialised variant (-D options) is compiled once, however many renders use it.
+// Thread-safe.
+cl::Program cached_program(const DeviceContext& device, const std::string& file,
+                           const std::string& options);
 
 // A kernel by name, throwing ClError.
 cl::Kernel make_kernel(const cl::Program& program, const char* name);

@@ -14,6 +14,7 @@
 #include "bvh/bvh.h"
 #include "cl/cl_error.h"
 #include "cl/device.h"
+#include "cli/integrate.h"
 #include "cli/progress.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
@@ -33,6 +34,7 @@ struct RenderOptions {
     int width = 512, height = 512;
     uint32_t spp = 16;
     std::string estimator = "light-area", light_select = "power", sampler = "independent";
+    std::string mis_heuristic = "balance";
     uint32_t seed = 0;
     std::string sky = "1";
     float ao_distance = 0.0f;
@@ -56,10 +58,6 @@ const CLI::Validator kFinite(
         return "'" + text + "' is not a finite number";
     },
     "FINITE");
-
-const std::vector<std::string> kEstimators = {
-    "hemisphere-uniform", "hemisphere-cosine", "light-area",      "light-solid-angle", "mis",
-    "ambient-uniform",    "ambient-cosine",    "ambient-fibonacci"};
 
 // An output's directory must exist before rendering starts, not after.
 void check_output_path(const std::string& path, const char* option) {
@@ -131,10 +129,7 @@ int run_devices() {
 
 int run_render(const RenderOptions& o) {
     auto start = std::chrono::steady_clock::now();
-    if (o.sampler != "independent") throw InputError("--sampler " + o.sampler + ": not yet supported");
     if (o.time_limit > 0) throw InputError("--time-limit: not yet supported");
-    if (o.light_select == "alias") throw InputError("--light-select alias: not yet supported");
-    parse_sky(o.sky);  // validated now; used by the ambient estimators
     check_output_path(o.out, "--out");
     check_output_path(o.png, "--png");
     check_output_path(o.stats, "--stats");
@@ -144,14 +139,23 @@ int run_render(const RenderOptions& o) {
     settings.height = o.height;
     settings.spp = o.spp;
     settings.estimator = o.estimator;
-    settings.light_select = o.light_select == "uniform" ? LightSelect::Uniform : LightSelect::Power;
+    settings.light_select = o.light_select == "uniform" ? LightSelect::Uniform
+                            : o.light_select == "alias" ? LightSelect::Alias
+                                                        : LightSelect::Power;
+    settings.sampler = o.sampler == "stratified" ? SamplerKind::Stratified
+                       : o.sampler == "sobol"    ? SamplerKind::Sobol
+                                                 : SamplerKind::Independent;
+    settings.mis_heuristic = o.mis_heuristic == "power" ? MisHeuristic::Power : MisHeuristic::Balance;
+    settings.sky = parse_sky(o.sky);
+    settings.ao_distance = o.ao_distance;
     settings.seed = o.seed;
     settings.batch = o.batch;
     render_program_options(settings);  // rejects what is not supported before any work
 
     Scene scene = load_gltf(o.scene, print_warning);
     if (scene.triangle_count() == 0) print_warning(o.scene + ": the scene has no triangles");
-    if (collect_emitters(scene).empty())
+    bool ambient = o.estimator.rfind("ambient-", 0) == 0;
+    if (!ambient && collect_emitters(scene).empty())
         print_warning(o.scene + ": no emissive triangles: direct lighting is black");
     Camera camera;
     if (o.camera >= 0) {
@@ -178,7 +182,7 @@ int run_render(const RenderOptions& o) {
     std::map<std::string, std::string> attributes = {
         {"mcrt.scene", o.scene},         {"mcrt.estimator", o.estimator},
         {"mcrt.light_select", o.light_select}, {"mcrt.sampler", o.sampler},
-        {"mcrt.seed", std::to_string(o.seed)}};
+        {"mcrt.seed", std::to_string(o.seed)}, {"mcrt.mis_heuristic", o.mis_heuristic}};
     write_exr(o.out, result.image, attributes);
     if (!o.png.empty()) write_png(o.png, result.image, o.exposure);
 
@@ -194,6 +198,9 @@ int run_render(const RenderOptions& o) {
             {"light_select", o.light_select},
             {"sampler", o.sampler},
             {"seed", o.seed},
+            {"mis_heuristic", o.mis_heuristic},
+            {"sky", {settings.sky.r, settings.sky.g, settings.sky.b}},
+            {"ao_distance", o.ao_distance},
             {"seconds_total", total},
             {"seconds_render", result.seconds_render},
             {"seconds_kernel_build", result.seconds_build},
@@ -246,6 +253,9 @@ int run_cli(int argc, char** argv) {
         ->check(CLI::IsMember({"uniform", "power", "alias"}));
     render_cmd->add_option("--sampler", o.sampler, "sample generator")->capture_default_str()
         ->check(CLI::IsMember({"independent", "stratified", "sobol"}));
+    render_cmd->add_option("--mis-heuristic", o.mis_heuristic, "MIS weights (estimator mis)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"balance", "power"}));
     render_cmd->add_option("--seed", o.seed, "random seed")->capture_default_str();
     render_cmd->add_option("--sky", o.sky, "sky radiance R,G,B (ambient estimators)")->capture_default_str();
     render_cmd->add_option("--ao-distance", o.ao_distance, "ambient occlusion distance, 0 = unbounded")->capture_default_str()
@@ -263,6 +273,8 @@ int run_cli(int argc, char** argv) {
     CLI::App* bench_cmd = app.add_subcommand("bench", "time ray queries on a scene");
     std::string bench_scene;
     bench_cmd->add_option("scene", bench_scene, "glTF scene")->required();
+    IntegrateOptions integrate_options;
+    add_integrate_command(app, integrate_options);
 
     try {
         app.parse(argc, argv);
@@ -282,6 +294,7 @@ int run_cli(int argc, char** argv) {
                 throw InputError("--width × --height × --spp is too large");
             return run_render(o);
         }
+        if (app.got_subcommand("integrate")) return run_integrate(integrate_options);
         if (app.got_subcommand("bench")) throw InputError("bench: not yet supported");
     } catch (const InputError& e) {
         std::cerr << "mcrt: error: " << e.what() << std::endl;

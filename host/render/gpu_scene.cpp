@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "cl/cl_error.h"
+#include "render/discrete.h"
 
 namespace mcrt {
 
@@ -41,12 +42,11 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
     }
     if (data.materials.empty()) data.materials.push_back(gpu::Material{});
 
-    // Power CDF over the emitters (PBRT 3rd ed. 13.3.1), accumulated in double.
+    // Lights in emitter order, selected by power (PBRT 3rd ed. 13.3.1); each triangle records
+    // its light so that a direction that hits it can ask the light strategy's density.
     std::vector<EmissiveTriangle> emitters = collect_emitters(scene);
-    double total_power = 0;
-    for (const EmissiveTriangle& e : emitters) total_power += e.power;
-    data.light_cdf.push_back(0.0f);
-    double running = 0;
+    std::vector<double> powers;
+    std::vector<uint32_t> light_of_triangle(scene.triangle_count(), 0);
     for (const EmissiveTriangle& e : emitters) {
         const Material& m = scene.materials[scene.triangle_material[e.triangle]];
         const glm::vec3* p = &scene.positions[3 * size_t(e.triangle)];
@@ -56,10 +56,16 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
         light.p2 = to_float4(p[2]);
         light.Le = to_float4(m.emission);
         data.lights.push_back(light);
-        running += e.power;
-        data.light_cdf.push_back(float(running / total_power));
+        powers.push_back(e.power);
+        light_of_triangle[e.triangle] = uint32_t(data.lights.size());
     }
-    if (!emitters.empty()) data.light_cdf.back() = 1.0f;
+    data.light_cdf = build_cdf(powers);
+    data.light_alias = build_alias_table(powers);
+    for (gpu::Triangle& t : data.triangles) {
+        uint32_t scene_triangle;
+        std::memcpy(&scene_triangle, &t.p1.w, sizeof scene_triangle);
+        t.p2.w = uint_bits(light_of_triangle[scene_triangle]);
+    }
     data.camera = make_gpu_camera(camera, width, height);
     return data;
 }
@@ -88,6 +94,7 @@ GpuSceneBuffers::GpuSceneBuffers(const DeviceContext& device, const GpuSceneData
     materials = upload(device, data.materials, bytes, "materials");
     lights = upload(device, data.lights, bytes, "lights");
     light_cdf = upload(device, data.light_cdf, bytes, "light CDF");
+    light_alias = upload(device, data.light_alias, bytes, "light alias table");
     camera = upload(device, std::vector<gpu::CameraGpu>{data.camera}, bytes, "camera");
     light_count = cl_uint(data.lights.size());
 }

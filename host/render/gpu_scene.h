@@ -14,7 +14,7 @@
 
 namespace mcrt {
 
-enum class LightSelect { Uniform, Power };
+enum class LightSelect { Uniform, Power, Alias };
 
 struct GpuSceneData {
     std::vector<gpu::BvhNode> nodes;
@@ -22,6 +22,7 @@ struct GpuSceneData {
     std::vector<gpu::Material> materials;
     std::vector<gpu::Light> lights;
     std::vector<float> light_cdf;  // lights + 1 entries, by power (PBRT 3rd ed. 13.3.1)
+    std::vector<gpu::AliasEntry> light_alias;  // the same distribution as an alias table
     gpu::CameraGpu camera{};
 };
 
@@ -35,7 +36,7 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
 // Device copies of GpuSceneData (empty arrays get a one-element buffer, never a null one).
 struct GpuSceneBuffers {
     GpuSceneBuffers(const DeviceContext& device, const GpuSceneData& data);
-    cl::Buffer nodes, triangles, materials, lights, light_cdf, camera;
+    cl::Buffer nodes, triangles, materials, lights, light_cdf, light_alias, camera;
     cl_uint light_count = 0;
     size_t bytes = 0;
 };

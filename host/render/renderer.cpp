@@ -47,14 +47,29 @@ Image Accumulator::image(uint32_t spp) const {
     return img;
 }
 
+const std::vector<std::string> kEstimators = {
+    "hemisphere-uniform", "hemisphere-cosine", "light-area",      "light-solid-angle", "mis",
+    "ambient-uniform",    "ambient-cosine",    "ambient-fibonacci"};
+
 std::string render_program_options(const RenderSettings& settings) {
-    std::string options = "-cl-std=CL1.2";
-    if (settings.estimator == "light-area")
-        options += " -D ESTIMATOR_LIGHT_AREA";
-    else
-        throw InputError("--estimator " + settings.estimator + ": not yet supported");
-    options += settings.light_select == LightSelect::Uniform ? " -D LIGHT_SELECT_UNIFORM"
-                                                             : " -D LIGHT_SELECT_POWER";
+    if (std::find(kEstimators.begin(), kEstimators.end(), settings.estimator) == kEstimators.end())
+        throw InputError("--estimator " + settings.estimator + ": unknown estimator");
+    // "light-solid-angle" → ESTIMATOR_LIGHT_SOLID_ANGLE
+    std::string macro = "ESTIMATOR_";
+    for (char c : settings.estimator) macro += c == '-' ? '_' : char(std::toupper(c));
+    std::string options = "-cl-std=CL1.2 -D " + macro;
+    switch (settings.light_select) {
+        case LightSelect::Uniform: options += " -D LIGHT_SELECT_UNIFORM"; break;
+        case LightSelect::Power: options += " -D LIGHT_SELECT_POWER"; break;
+        case LightSelect::Alias: options += " -D LIGHT_SELECT_ALIAS"; break;
+    }
+    switch (settings.sampler) {
+        case SamplerKind::Independent: options += " -D SAMPLER_INDEPENDENT"; break;
+        case SamplerKind::Stratified: options += " -D SAMPLER_STRATIFIED"; break;
+        case SamplerKind::Sobol: options += " -D SAMPLER_SOBOL"; break;
+    }
+    if (settings.estimator == "mis")
+        options += settings.mis_heuristic == MisHeuristic::Power ? " -D MIS_POWER" : " -D MIS_BALANCE";
     return options;
 }
 
@@ -96,9 +111,7 @@ RenderResult render(const DeviceContext& device, const GpuSceneData& scene,
     const uint32_t chunks = (batch + MCRT_SAMPLES_PER_CHUNK - 1) / MCRT_SAMPLES_PER_CHUNK;
 
     auto t0 = std::chrono::steady_clock::now();
-    cl::Program program = build_program(device.context, device.info.device,
-                                        kernel_source("render.cl"),
-                                        render_program_options(settings));
+    cl::Program program = cached_program(device, "render.cl", render_program_options(settings));
     result.seconds_build = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     cl::Kernel render_kernel = make_kernel(program, "render");
     cl::Kernel reduce_kernel = make_kernel(program, "reduce_chunks");
@@ -110,17 +123,22 @@ RenderResult render(const DeviceContext& device, const GpuSceneData& scene,
     cl::Buffer sums = device_buffer(device, CL_MEM_WRITE_ONLY, sums_bytes, "sum buffer");
     cl::Buffer sums_sq = device_buffer(device, CL_MEM_WRITE_ONLY, sums_bytes, "sum buffer");
 
+    const cl_float4 sky = {{settings.sky.r, settings.sky.g, settings.sky.b, 0.0f}};
     CL_CHECK(render_kernel.setArg(0, buffers.nodes));
     CL_CHECK(render_kernel.setArg(1, buffers.triangles));
     CL_CHECK(render_kernel.setArg(2, buffers.materials));
     CL_CHECK(render_kernel.setArg(3, buffers.lights));
     CL_CHECK(render_kernel.setArg(4, buffers.light_cdf));
-    CL_CHECK(render_kernel.setArg(5, buffers.light_count));
-    CL_CHECK(render_kernel.setArg(6, buffers.camera));
-    CL_CHECK(render_kernel.setArg(7, cl_uint(width)));
-    CL_CHECK(render_kernel.setArg(8, cl_uint(height)));
-    CL_CHECK(render_kernel.setArg(9, cl_uint(settings.seed)));
-    CL_CHECK(render_kernel.setArg(12, samples));
+    CL_CHECK(render_kernel.setArg(5, buffers.light_alias));
+    CL_CHECK(render_kernel.setArg(6, buffers.light_count));
+    CL_CHECK(render_kernel.setArg(7, buffers.camera));
+    CL_CHECK(render_kernel.setArg(8, cl_uint(width)));
+    CL_CHECK(render_kernel.setArg(9, cl_uint(height)));
+    CL_CHECK(render_kernel.setArg(10, cl_uint(settings.seed)));
+    CL_CHECK(render_kernel.setArg(11, cl_uint(settings.spp)));
+    CL_CHECK(render_kernel.setArg(12, sky));
+    CL_CHECK(render_kernel.setArg(13, cl_float(settings.ao_distance)));
+    CL_CHECK(render_kernel.setArg(16, samples));
     CL_CHECK(reduce_kernel.setArg(0, samples));
     CL_CHECK(reduce_kernel.setArg(2, pixels));
     CL_CHECK(reduce_kernel.setArg(3, sums));
@@ -134,8 +152,8 @@ RenderResult render(const DeviceContext& device, const GpuSceneData& scene,
         // Batches start on chunk boundaries: only the last may be shorter.
         const cl_uint n = std::min(batch, settings.spp - begin);
         const cl_uint n_chunks = (n + MCRT_SAMPLES_PER_CHUNK - 1) / MCRT_SAMPLES_PER_CHUNK;
-        CL_CHECK(render_kernel.setArg(10, cl_uint(begin)));
-        CL_CHECK(render_kernel.setArg(11, n));
+        CL_CHECK(render_kernel.setArg(14, cl_uint(begin)));
+        CL_CHECK(render_kernel.setArg(15, n));
         CL_CHECK(reduce_kernel.setArg(1, n));
         cl::Event render_done, reduce_done;
         CL_CHECK(device.queue.enqueueNDRangeKernel(render_kernel, cl::NullRange,

@@ -6,20 +6,32 @@
 #include <string>
 #include <vector>
 
+#include <glm/glm.hpp>
+
 #include "cl/device.h"
 #include "image/image.h"
 #include "render/gpu_scene.h"
 
 namespace mcrt {
 
+enum class SamplerKind { Independent, Stratified, Sobol };
+enum class MisHeuristic { Balance, Power };
+
 struct RenderSettings {
     int width = 512, height = 512;
     uint32_t spp = 16;
-    std::string estimator = "light-area";
+    std::string estimator = "light-area";  // a name of kEstimators
     LightSelect light_select = LightSelect::Power;
+    SamplerKind sampler = SamplerKind::Independent;
+    MisHeuristic mis_heuristic = MisHeuristic::Balance;
+    glm::vec3 sky{1.0f};        // ambient estimators: uniform sky radiance
+    float ao_distance = 0.0f;   // ambient estimators: occlusion range, 0 = unbounded
     uint32_t seed = 0;
     uint32_t batch = 0;  // samples per pixel per launch; 0 chooses; rounded up to whole chunks
 };
+
+// The estimators of DESIGN.md, by their command-line names.
+extern const std::vector<std::string> kEstimators;
 
 struct DeviceReport {
     std::string name;
@@ -58,7 +70,8 @@ private:
     uint64_t nan_samples_ = 0, rays_ = 0;
 };
 
-// The -D options of the render program for these settings.
+// The -D options of the render program for these settings (throws InputError for an unknown
+// estimator).
 std::string render_program_options(const RenderSettings& settings);
 
 // Renders on one device. Throws InputError for settings it cannot honour, RuntimeError /

@@ -1,0 +1,24 @@
+// Discrete distributions for the kernels' samplers (kernels/discrete.cl): a CDF for inversion by
+// binary search and an alias table, both built from non-negative weights.
+#pragma once
+
+#include <vector>
+
+#include "shared_types.h"
+
+namespace mcrt {
+
+// CDF of weights / Σweights as n + 1 floats: cdf[0] = 0, cdf[n] = 1 exactly, accumulated in
+// double. A zero weight gives an empty interval (cdf[i+1] == cdf[i]), never sampled; so does a
+// positive weight below float resolution of its cdf entries (pmf < ~6e-8). Empty or all-zero
+// weights give {0}: a distribution of no entries, which callers must not sample. Throws
+// InputError on a negative or non-finite weight, or a non-finite sum.
+std::vector<float> build_cdf(const std::vector<double>& weights);
+
+// Alias table of weights / Σweights (Vose 1991, "A linear algorithm for generating random
+// numbers with a given distribution"), one entry per weight, each with its own pmf. Zero-weight
+// entries get prob 0 and are never the alias of another. Empty or all-zero weights give an
+// empty table. Throws as build_cdf.
+std::vector<gpu::AliasEntry> build_alias_table(const std::vector<double>& weights);
+
+}  // namespace mcrt

@@ -1,0 +1,264 @@
+// Every estimator × light selection × sampler against exact images: a polygon light over a
+// plane (Lambert's formula), a furnace (an emitting, reflecting sphere around the camera), and
+// ambient light next to a wall (the wall's projected solid angle). Standard errors come from
+// independent renders, so they hold for stratified and Sobol samplers too.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "analytic_scenes.h"
+#include "bvh/bvh.h"
+#include "device_support.h"
+#include "render/renderer.h"
+
+using namespace mcrt;
+using namespace mcrt::test;
+
+namespace {
+
+const char* sampler_name(SamplerKind s) {
+    return s == SamplerKind::Independent ? "independent"
+           : s == SamplerKind::Stratified ? "stratified"
+                                          : "sobol";
+}
+
+const char* select_name(LightSelect s) {
+    return s == LightSelect::Uniform ? "uniform" : s == LightSelect::Power ? "power" : "alias";
+}
+
+struct Renders {
+    std::vector<glm::dvec3> means;  // image mean of each independent render
+    glm::dvec3 mean{0.0}, standard_error{0.0};
+    double mean_layer_variance = 0;  // mean over renders of the variance layer's image mean
+    uint64_t nan_samples = 0;
+};
+
+// `count` renders with seeds 1000, 1001, ...: the mean of their image means and its standard
+// error from their spread.
+Renders independent_renders(const DeviceContext& device, const GpuSceneData& data,
+                            RenderSettings settings, int count) {
+    Renders r;
+    for (int k = 0; k < count; ++k) {
+        settings.seed = 1000u + uint32_t(k);
+        RenderResult result = render(device, data, settings);
+        glm::dvec3 m(0.0);
+        double layer = 0;
+        size_t n = size_t(settings.width) * settings.height;
+        for (size_t p = 0; p < n; ++p)
+            for (int c = 0; c < 3; ++c) {
+                m[c] += result.image.rgb[3 * p + c] / double(n);
+                layer += result.image.variance[3 * p + c] / double(3 * n * n);
+            }
+        r.means.push_back(m);
+        r.mean += m / double(count);
+        r.mean_layer_variance += layer / count;
+        r.nan_samples += result.nan_samples;
+    }
+    glm::dvec3 var(0.0);
+    for (const glm::dvec3& m : r.means) var += (m - r.mean) * (m - r.mean) / double(count - 1);
+    r.standard_error = glm::sqrt(var / double(count));
+    return r;
+}
+
+glm::dvec3 image_mean(const std::vector<double>& img) {
+    glm::dvec3 m(0.0);
+    size_t n = img.size() / 3;
+    for (size_t p = 0; p < n; ++p)
+        for (int c = 0; c < 3; ++c) m[c] += img[3 * p + c] / double(n);
+    return m;
+}
+
+// |mean − exact| within 4.5 standard errors in every channel. With 10 renders the standard
+// error is itself uncertain (χ² with 9 degrees of freedom); 4.5 leaves room for that.
+void check_unbiased(const Renders& r, glm::dvec3 exact, const std::string& what) {
+    INFO(what << ": mean (" << r.mean.x << ", " << r.mean.y << ", " << r.mean.z << "), exact ("
+              << exact.x << ", " << exact.y << ", " << exact.z << "), standard error ("
+              << r.standard_error.x << ", " << r.standard_error.y << ", " << r.standard_error.z
+              << ")");
+    CHECK(r.nan_samples == 0);
+    for (int c = 0; c < 3; ++c) CHECK(std::abs(r.mean[c] - exact[c]) <= 4.5 * r.standard_error[c]);
+}
+
+constexpr int kRenders = 10;
+
+}  // namespace
+
+TEST_CASE("direct-light estimators are unbiased on a polygon light over a plane",
+          "[estimators][analytic]") {
+    DeviceContext device = first_device();
+    PlaneScene ps;
+    RenderSettings settings;
+    settings.width = 16;
+    settings.height = 16;
+    settings.spp = 64;
+    Bvh bvh = build_bvh(ps.scene);
+    GpuSceneData data = make_gpu_scene(ps.scene, bvh, ps.camera, settings.width, settings.height);
+    glm::dvec3 exact = image_mean(ps.exact_image(settings.width, settings.height));
+
+    struct Variant {
+        const char* estimator;
+        MisHeuristic heuristic;
+        bool uses_lights;
+    };
+    const Variant variants[] = {{"light-area", MisHeuristic::Balance, true},
+                                {"light-solid-angle", MisHeuristic::Balance, true},
+                                {"mis", MisHeuristic::Balance, true},
+                                {"mis", MisHeuristic::Power, true},
+                                {"hemisphere-uniform", MisHeuristic::Balance, false},
+                                {"hemisphere-cosine", MisHeuristic::Balance, false}};
+    for (const Variant& v : variants)
+        for (LightSelect select : {LightSelect::Uniform, LightSelect::Power, LightSelect::Alias}) {
+            if (!v.uses_lights && select != LightSelect::Power) continue;
+            for (SamplerKind sampler :
+                 {SamplerKind::Independent, SamplerKind::Stratified, SamplerKind::Sobol}) {
+                settings.estimator = v.estimator;
+                settings.mis_heuristic = v.heuristic;
+                settings.light_select = select;
+                settings.sampler = sampler;
+                // Hemisphere sampling rarely finds these small lights: give it more samples.
+                settings.spp = v.uses_lights ? 64 : 1024;
+                Renders r = independent_renders(device, data, settings, kRenders);
+                std::string what = std::string(v.estimator) +
+                                   (v.heuristic == MisHeuristic::Power ? " (power)" : "") + " / " +
+                                   select_name(select) + " / " + sampler_name(sampler);
+                check_unbiased(r, exact, what);
+                // Not vacuous: the error bar is a few percent of the value at most.
+                CHECK(r.standard_error.x < 0.05 * exact.x);
+            }
+        }
+}
+
+TEST_CASE("in a furnace every estimator is unbiased and the cosine estimator has zero variance",
+          "[estimators][analytic]") {
+    // A sphere emitting Le inward and reflecting with albedo ρ around the camera: every point
+    // sees Le in all directions, so a pixel is Le + ρ·Le exactly.
+    DeviceContext device = first_device();
+    Scene scene;
+    const glm::vec3 Le(0.5f, 1.0f, 2.0f), albedo(0.8f, 0.5f, 0.2f);
+    uint32_t m = add_material(scene, albedo, Le);
+    add_sphere(scene, glm::vec3(0.0f), 1.0f, 24, 12, m, /*inward=*/true);
+    Camera camera = looking_down(glm::vec3(0.1f, 0.2f, 0.0f), glm::radians(90.0f));
+    RenderSettings settings;
+    settings.width = 8;
+    settings.height = 8;
+    settings.spp = 32;
+    Bvh bvh = build_bvh(scene);
+    GpuSceneData data = make_gpu_scene(scene, bvh, camera, settings.width, settings.height);
+    glm::dvec3 exact = glm::dvec3(Le) * (1.0 + glm::dvec3(albedo));
+    for (const char* estimator :
+         {"light-area", "light-solid-angle", "mis", "hemisphere-uniform", "hemisphere-cosine"}) {
+        settings.estimator = estimator;
+        Renders r = independent_renders(device, data, settings, kRenders);
+        if (std::string(estimator) == "hemisphere-cosine") {
+            // f·Le·cosθ / (cosθ/π) = ρ·Le for every sample: only rounding is left.
+            INFO("cosine: mean " << r.mean.x << ", layer variance " << r.mean_layer_variance);
+            for (int c = 0; c < 3; ++c) CHECK(r.mean[c] == Approx(exact[c]).epsilon(1e-5));
+            // The layer's per-sample spread is float rounding of the sums of squares
+            // (a few 1e-5 of the value), not Monte Carlo noise.
+            double mean_value = (r.mean.x + r.mean.y + r.mean.z) / 3.0;
+            CHECK(std::sqrt(r.mean_layer_variance * settings.spp) < 1e-4 * mean_value);
+        } else {
+            check_unbiased(r, exact, estimator);
+            CHECK(r.mean_layer_variance > 0.0);
+        }
+    }
+}
+
+TEST_CASE("ambient estimators are unbiased next to a wall (its projected solid angle)",
+          "[estimators][analytic]") {
+    // Floor y = 0 and a wall x = 0 of height 1 and width 3; the camera sees only floor. At a
+    // floor point the unoccluded fraction of (1/π)∫cosθ dω is 1 − F, F = the wall's form factor
+    // = Lambert's irradiance from the wall polygon with L = 1, over π.
+    DeviceContext device = first_device();
+    Scene scene;
+    const glm::dvec3 albedo(0.7, 0.6, 0.5), sky(1.0, 2.0, 0.5);
+    uint32_t floor = add_material(scene, glm::vec3(albedo));
+    uint32_t wall = add_material(scene, glm::vec3(0.3f));
+    add_quad(scene, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, floor);
+    std::vector<glm::dvec3> wall_polygon = {{0, 0, -1.5}, {0, 1, -1.5}, {0, 1, 1.5}, {0, 0, 1.5}};
+    add_quad(scene, wall_polygon[0], wall_polygon[1], wall_polygon[2], wall_polygon[3], wall);
+    Camera camera = looking_down(glm::vec3(0.7f, 3.0f, 0.0f), 2.0f * std::atan(0.5f / 3.0f));
+    RenderSettings settings;
+    settings.width = 16;
+    settings.height = 16;
+    settings.spp = 64;
+    settings.sky = glm::vec3(sky);
+    Bvh bvh = build_bvh(scene);
+    GpuSceneData data = make_gpu_scene(scene, bvh, camera, settings.width, settings.height);
+    glm::dvec3 exact = image_mean(exact_plane_image(camera, 16, 16, [&](glm::dvec3 p) {
+        double form_factor = lambert_irradiance(wall_polygon, p, {0, 1, 0}, 1.0) / M_PI;
+        return albedo * sky * (1.0 - form_factor);
+    }));
+    for (const char* estimator : {"ambient-uniform", "ambient-cosine", "ambient-fibonacci"})
+        for (SamplerKind sampler :
+             {SamplerKind::Independent, SamplerKind::Stratified, SamplerKind::Sobol}) {
+            settings.estimator = estimator;
+            settings.sampler = sampler;
+            Renders r = independent_renders(device, data, settings, kRenders);
+            check_unbiased(r, exact, std::string(estimator) + " / " + sampler_name(sampler));
+            CHECK(r.standard_error.x < 0.02 * exact.x);
+        }
+}
+
+TEST_CASE("ambient occlusion distance: a far wall stops occluding", "[estimators]") {
+    DeviceContext device = first_device();
+    Scene scene;
+    uint32_t floor = add_material(scene, glm::vec3(1.0f));
+    add_quad(scene, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, floor);
+    add_quad(scene, {0, 0, -1.5}, {0, 1, -1.5}, {0, 1, 1.5}, {0, 0, 1.5}, floor);
+    Camera camera = looking_down(glm::vec3(0.7f, 3.0f, 0.0f), 0.2f);
+    RenderSettings settings;
+    settings.width = 4;
+    settings.height = 4;
+    settings.spp = 64;
+    settings.estimator = "ambient-cosine";
+    settings.ao_distance = 0.1f;  // the wall is 0.6 or more away: nothing occludes
+    Bvh bvh = build_bvh(scene);
+    GpuSceneData data = make_gpu_scene(scene, bvh, camera, settings.width, settings.height);
+    RenderResult r = render(device, data, settings);
+    for (float v : r.image.rgb) CHECK(v == Approx(1.0f).epsilon(1e-6));
+}
+
+TEST_CASE("power and alias selection have lower variance than uniform with unequal lights",
+          "[estimators]") {
+    DeviceContext device = first_device();
+    PlaneScene ps;
+    RenderSettings settings;
+    settings.width = 16;
+    settings.height = 16;
+    settings.spp = 64;
+    Bvh bvh = build_bvh(ps.scene);
+    GpuSceneData data = make_gpu_scene(ps.scene, bvh, ps.camera, settings.width, settings.height);
+    double layer[3];
+    for (LightSelect select : {LightSelect::Uniform, LightSelect::Power, LightSelect::Alias}) {
+        settings.light_select = select;
+        layer[int(select)] = independent_renders(device, data, settings, 4).mean_layer_variance;
+    }
+    INFO("variance: uniform " << layer[0] << ", power " << layer[1] << ", alias " << layer[2]);
+    CHECK(layer[1] < layer[0]);
+    CHECK(layer[2] < layer[0]);
+    // The same distribution: within the noise of the variance estimates.
+    CHECK(layer[2] == Approx(layer[1]).epsilon(0.1));
+}
+
+TEST_CASE("with the independent sampler the variance layer predicts the spread of renders",
+          "[estimators]") {
+    DeviceContext device = first_device();
+    PlaneScene ps;
+    RenderSettings settings;
+    settings.width = 16;
+    settings.height = 16;
+    settings.spp = 32;
+    Bvh bvh = build_bvh(ps.scene);
+    GpuSceneData data = make_gpu_scene(ps.scene, bvh, ps.camera, settings.width, settings.height);
+    const int renders = 40;
+    Renders r = independent_renders(device, data, settings, renders);
+    // Variance of the image mean predicted by the layer, against the spread of 40 renders; the
+    // spread's own relative uncertainty is √(2/39) ≈ 23%, so 35% is about 1.5 of its σ.
+    double predicted = r.mean_layer_variance;
+    double observed = 0;
+    for (int c = 0; c < 3; ++c)
+        observed += r.standard_error[c] * r.standard_error[c] * renders / 3.0;
+    INFO("predicted " << predicted << ", observed " << observed);
+    CHECK(observed == Approx(predicted).epsilon(0.35));
+}
