@@ -262,9 +262,9 @@ TEST_CASE("bad usage exits 2 with one error line and writes nothing", "[cli]") {
          {"--out", "@D/missing"}},
         {"--png into a missing directory", render({"--png", "@D/missing/x.png"}), {"--png", "@D/missing"}},
         {"missing scene file", {"render", "@D/no such scene.gltf", "--out", "@D/x.exr"}, {"no such scene.gltf"}},
-        {"estimator mis", render({"--estimator", "mis"}), {"mis", "not yet supported"}},
-        {"light-select alias", render({"--light-select", "alias"}), {"alias", "not yet supported"}},
-        {"sampler sobol", render({"--sampler", "sobol"}), {"sobol", "not yet supported"}},
+        {"unknown light selection", render({"--light-select", "nope"}), {"nope", "uniform", "power", "alias"}},
+        {"unknown sampler", render({"--sampler", "nope"}), {"nope", "independent", "stratified", "sobol"}},
+        {"unknown MIS heuristic", render({"--mis-heuristic", "nope"}), {"nope", "balance", "power"}},
         {"time-limit", render({"--time-limit", "1"}), {"--time-limit", "not yet supported"}},
         {"camera out of range", render({"--camera", "5"}), {"--camera"}},
         {"device 99", render({"--device", "99"}), {"--device", "99"}},
@@ -291,6 +291,31 @@ TEST_CASE("bad usage exits 2 with one error line and writes nothing", "[cli]") {
         INFO("left behind: " << joined(box.files()));
         CHECK(box.files().empty());
     }
+}
+
+TEST_CASE("every estimator, light selection and sampler renders from the command line", "[cli]") {
+    for (const char* estimator : {"hemisphere-uniform", "hemisphere-cosine", "light-area", "light-solid-angle",
+                                  "mis", "ambient-uniform", "ambient-cosine", "ambient-fibonacci"})
+        for (const char* select : {"uniform", "power", "alias"})
+            for (const char* sampler : {"independent", "stratified", "sobol"}) {
+                // Every name once; the combinations are the estimator tests' job.
+                bool light_estimator = std::string(estimator).rfind("light-", 0) == 0;
+                if (std::string(select) != "power" && !(light_estimator && std::string(sampler) == "independent"))
+                    continue;
+                Sandbox box;
+                ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("x.exr"), "--estimator",
+                                                  estimator, "--light-select", select, "--sampler", sampler},
+                                                 kSmall));
+                INFO(estimator << " / " << select << " / " << sampler << "\n  stderr: " << r.err);
+                REQUIRE(r.exit_code == 0);
+                Image img = read_exr(box.out("x.exr"));
+                double sum = 0;
+                for (float v : img.rgb) {
+                    REQUIRE(std::isfinite(v));
+                    sum += v;
+                }
+                CHECK(sum > 0);
+            }
 }
 
 TEST_CASE("a rejected render leaves an existing output untouched", "[cli]") {
