@@ -84,7 +84,7 @@ inline float2 sample_disk_concentric(float2 u) {
 /* Inverse of sample_disk_concentric: the square's sector from the polar angle. */
 inline float2 invert_disk_concentric(float2 p) {
     float r = hypot(p.x, p.y);
-    float phi = atan2(p.y, p.x); /* (−π, π] */
+    float phi = atan2(p.y, p.x);                     /* (−π, π] */
     if (phi < -0.25f * M_PI_F) phi += 2.0f * M_PI_F; /* [−π/4, 7π/4) */
     float k = 4.0f * INV_PI_F, a, b;
     if (phi < 0.25f * M_PI_F) { /* right sector: r = a */
@@ -115,9 +115,7 @@ inline float3 sample_hemisphere_cosine(float2 u) {
 }
 
 /* Density of sample_hemisphere_cosine with respect to solid angle: cosθ/π above the horizon. */
-inline float sample_hemisphere_cosine_pdf_w(float3 w) {
-    return w.z > 0.0f ? w.z * INV_PI_F : 0.0f;
-}
+inline float sample_hemisphere_cosine_pdf_w(float3 w) { return w.z > 0.0f ? w.z * INV_PI_F : 0.0f; }
 
 inline float2 invert_hemisphere_cosine(float3 w) { return invert_disk_concentric(w.xy); }
 
@@ -138,9 +136,9 @@ inline float spherical_triangle_solid_angle(float3 a, float3 b, float3 c) {
  * 1. c' = cos θ·a + sin θ·c⊥ on the arc a→c such that Ω(a, b, c') = u0·Ω. With t = tan(θ/2),
  *    T = a·(b×c⊥), tan(Ω'/2) = t|T| / (1 + a·b + t·b·c⊥), which is linear in t once Ω' is set.
  * 2. w on the arc b→c' with 1 − w·b uniform in [0, 1 − c'·b] (uniform over the thin wedge).
- * Accurate (χ²-tested) down to ~1e-3 sr and usable below; callers sample lights of less than
- * ~3e-4 sr by area instead, as pbrt-v4 does. Never NaN: a degenerate triangle gives a vertex
- * average. */
+ * χ²-tested from 4 sr down to 1e-3 sr; inside the triangle and invertible down to 1e-7 sr and
+ * slivers, but callers sample lights below ~3e-4 sr by area instead, as pbrt-v4 does. Never
+ * NaN: a degenerate triangle (Ω = 0) gives the normalized vertex average. */
 inline float3 sample_spherical_triangle(float3 a, float3 b, float3 c, float2 u) {
     float3 fallback = normalize_or(a + b + c, a);
     float omega = spherical_triangle_solid_angle(a, b, c);

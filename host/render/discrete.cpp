@@ -18,7 +18,8 @@ double checked_total(const std::vector<double>& weights) {
                              std::to_string(weights[i]) + ", not a finite non-negative number");
         total += weights[i];
     }
-    if (!std::isfinite(total)) throw InputError("discrete distribution: the weights' sum overflows");
+    if (!std::isfinite(total))
+        throw InputError("discrete distribution: the weights' sum overflows");
     return total;
 }
 
