@@ -4,17 +4,18 @@
 #include "estimators.cl"
 
 /* One work-item per pixel sample of a batch. Work-item g renders sample
- * sample_begin + g % batch_samples (of spp in all) of pixel g / batch_samples (samples of a
- * pixel adjacent) and writes samples[g] = (radiance, number of rays traced). */
+ * sample_begin + g % batch_samples (of spp in all) of pixel pixel_begin + g / batch_samples
+ * < pixel_end (samples of a pixel adjacent) and writes samples[g] = (radiance, rays traced). */
 kernel void render(global const BvhNode* nodes, global const Triangle* triangles,
                    global const Material* materials, global const Light* lights,
                    global const float* light_cdf, global const AliasEntry* light_alias,
                    uint light_count, global const CameraGpu* camera, uint width, uint height,
-                   uint seed, uint spp, float4 sky, float ao_distance, uint sample_begin,
-                   uint batch_samples, global float4* samples) {
+                   uint seed, uint spp, float4 sky, float ao_distance, uint pixel_begin,
+                   uint pixel_end, uint sample_begin, uint batch_samples,
+                   global float4* samples) {
     size_t g = get_global_id(0);
-    uint pixel = (uint)(g / batch_samples);
-    if (pixel >= width * height) return;
+    uint pixel = pixel_begin + (uint)(g / batch_samples);
+    if (pixel >= pixel_end) return; /* the global size is rounded up to whole work-groups */
 
     SampleStream stream;
     stream.pixel = pixel;

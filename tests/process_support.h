@@ -84,9 +84,11 @@ private:
 
 // Runs `program` with `args` (argv[0] is the program path), stdin from /dev/null, stdout and
 // stderr into files under `scratch`. A child still running after `timeout_seconds` is killed
-// with SIGKILL and reported as timed_out.
+// with SIGKILL and reported as timed_out. With `send_signal`, that signal is sent to the child
+// once, `signal_after` seconds after it started.
 inline ProcessResult run_process(const std::string& program, const std::vector<std::string>& args,
-                                 const std::filesystem::path& scratch, double timeout_seconds = 120.0) {
+                                 const std::filesystem::path& scratch, double timeout_seconds = 120.0,
+                                 int send_signal = 0, double signal_after = 0.0) {
     static std::atomic<unsigned> counter{0};
     unsigned id = counter++;
     std::string out_path = (scratch / ("stdout-" + std::to_string(id) + ".txt")).string();
@@ -119,6 +121,10 @@ inline ProcessResult run_process(const std::string& program, const std::vector<s
         if (done == pid) break;
         if (done < 0 && errno != EINTR) throw std::runtime_error(std::string("waitpid: ") + std::strerror(errno));
         double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (send_signal != 0 && elapsed >= signal_after) {
+            kill(pid, send_signal);
+            send_signal = 0;
+        }
         if (elapsed > timeout_seconds) {
             kill(pid, SIGKILL);
             while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}

@@ -265,7 +265,6 @@ TEST_CASE("bad usage exits 2 with one error line and writes nothing", "[cli]") {
         {"unknown light selection", render({"--light-select", "nope"}), {"nope", "uniform", "power", "alias"}},
         {"unknown sampler", render({"--sampler", "nope"}), {"nope", "independent", "stratified", "sobol"}},
         {"unknown MIS heuristic", render({"--mis-heuristic", "nope"}), {"nope", "balance", "power"}},
-        {"time-limit", render({"--time-limit", "1"}), {"--time-limit", "not yet supported"}},
         {"camera out of range", render({"--camera", "5"}), {"--camera"}},
         {"device 99", render({"--device", "99"}), {"--device", "99"}},
         {"device bogus", render({"--device", "bogus"}), {"--device", "bogus"}},

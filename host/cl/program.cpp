@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "cl/binary_cache.h"
 #include "cl/cl_error.h"
 
 namespace mcrt {
@@ -86,8 +87,17 @@ cl::Program cached_program(const DeviceContext& device, const std::string& file,
     std::lock_guard<std::mutex> lock(mutex);
     auto it = programs.find(key);
     if (it != programs.end()) return it->second;
+    // Across processes, the on-disk binary cache skips compilation on drivers without their own.
+    // PoCL caches compiled kernels itself (unless POCL_KERNEL_CACHE=0), and asking it for the
+    // binary costs a full code generation (~0.5 s per variant, docs/BENCHMARKS.md): skip it there.
+    const char* pocl_cache = std::getenv("POCL_KERNEL_CACHE");
+    bool driver_caches = device.info.platform_name.find("Portable Computing Language") !=
+                             std::string::npos &&
+                         !(pocl_cache && std::string(pocl_cache) == "0");
     cl::Program program =
-        build_program(device.context, device.info.device, kernel_source(file), options);
+        driver_caches ? build_program(device.context, device.info.device, kernel_source(file), options)
+                      : build_program_cached(device.context, device.info.device, device.info,
+                                             kernel_source(file), options);
     programs.emplace(key, program);
     return program;
 }

@@ -1,6 +1,7 @@
 #include "cli/cli.h"
 
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -24,6 +25,29 @@
 
 namespace mcrt {
 namespace {
+
+volatile std::sig_atomic_t g_interrupted = 0;
+
+extern "C" void on_interrupt(int) { g_interrupted = 1; }
+
+// While a render runs, SIGINT and SIGTERM ask it to stop and write the samples done so far;
+// a second signal ends the process at once.
+struct InterruptGuard {
+    InterruptGuard() {
+        g_interrupted = 0;
+        struct sigaction action {};
+        action.sa_handler = on_interrupt;
+        action.sa_flags = SA_RESETHAND;
+        sigemptyset(&action.sa_mask);
+        sigaction(SIGINT, &action, &old_int);
+        sigaction(SIGTERM, &action, &old_term);
+    }
+    ~InterruptGuard() {
+        sigaction(SIGINT, &old_int, nullptr);
+        sigaction(SIGTERM, &old_term, nullptr);
+    }
+    struct sigaction old_int {}, old_term {};
+};
 
 void print_warning(const std::string& message) {
     std::cerr << "mcrt: warning: " << message << std::endl;
@@ -129,7 +153,6 @@ int run_devices() {
 
 int run_render(const RenderOptions& o) {
     auto start = std::chrono::steady_clock::now();
-    if (o.time_limit > 0) throw InputError("--time-limit: not yet supported");
     check_output_path(o.out, "--out");
     check_output_path(o.png, "--png");
     check_output_path(o.stats, "--stats");
@@ -168,16 +191,31 @@ int run_render(const RenderOptions& o) {
     }
 
     std::vector<DeviceInfo> devices = select_devices(o.devices);
-    if (devices.size() > 1) throw InputError("--device: rendering on several devices is not yet supported");
-    DeviceContext device(devices.front());
+    std::vector<std::unique_ptr<DeviceContext>> contexts;
+    std::vector<const DeviceContext*> device_list;
+    for (const DeviceInfo& d : devices) {
+        contexts.push_back(std::make_unique<DeviceContext>(d));
+        device_list.push_back(contexts.back().get());
+    }
 
     Bvh bvh = build_bvh(scene);
     GpuSceneData gpu_scene = make_gpu_scene(scene, bvh, camera, o.width, o.height);
 
+    RenderControl control;
+    control.time_limit = o.time_limit;
+    control.interrupted = &g_interrupted;
+    InterruptGuard interrupt_guard;  // SIGINT / SIGTERM: stop and write what is done
     ProgressBar bar(!o.quiet, uint64_t(o.width) * o.height);
-    RenderResult result = render(device, gpu_scene, settings,
-                                 [&](uint32_t done, uint32_t total) { bar.update(done, total); });
+    RenderResult result = render(
+        device_list, gpu_scene, settings,
+        [&](uint32_t done, uint32_t total, const std::vector<DeviceReport>& d) {
+            bar.update(done, total, d);
+        },
+        control, print_warning);
     bar.finish();
+    if (!result.stopped_by.empty())
+        print_warning("stopped by " + result.stopped_by + " after " + std::to_string(result.spp) +
+                      " of " + std::to_string(o.spp) + " samples per pixel; writing those");
 
     std::map<std::string, std::string> attributes = {
         {"mcrt.scene", o.scene},         {"mcrt.estimator", o.estimator},
@@ -188,12 +226,14 @@ int run_render(const RenderOptions& o) {
 
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!o.stats.empty()) {
-        uint64_t samples = uint64_t(o.width) * o.height * o.spp;
+        uint64_t samples = uint64_t(o.width) * o.height * result.spp;
         nlohmann::json j = {
             {"scene", o.scene},
             {"width", o.width},
             {"height", o.height},
-            {"spp", o.spp},
+            {"spp", result.spp},
+            {"spp_requested", o.spp},
+            {"stopped_by", result.stopped_by},
             {"estimator", o.estimator},
             {"light_select", o.light_select},
             {"sampler", o.sampler},
@@ -216,8 +256,9 @@ int run_render(const RenderOptions& o) {
         };
         nlohmann::json devices_json = nlohmann::json::array();
         for (const DeviceReport& d : result.devices)
-            devices_json.push_back({{"name", d.name}, {"samples", d.samples}, {"batches", d.batches},
-                                    {"seconds_busy", d.seconds_busy},
+            devices_json.push_back({{"name", d.name}, {"index", d.index}, {"samples", d.samples},
+                                    {"batches", d.batches}, {"seconds_busy", d.seconds_busy},
+                                    {"retired", d.retired},
                                     {"samples_per_second", d.seconds_busy > 0 ? d.samples / d.seconds_busy : 0.0}});
         j["devices"] = devices_json;
         write_atomically(o.stats, [&](const std::string& tmp) {
@@ -228,7 +269,7 @@ int run_render(const RenderOptions& o) {
     }
     if (!o.quiet)
         std::cerr << "mcrt: wrote " << o.out << " (" << o.width << "x" << o.height << ", "
-                  << o.spp << " spp, " << result.seconds_render << " s on the device)" << std::endl;
+                  << result.spp << " spp, " << result.seconds_render << " s on the device)" << std::endl;
     return 0;
 }
 

@@ -1,6 +1,7 @@
 #include "cli/progress.h"
 
 #include <cstdio>
+#include <string>
 
 namespace mcrt {
 
@@ -8,7 +9,7 @@ ProgressBar::ProgressBar(bool enabled, uint64_t samples_per_spp)
     : enabled_(enabled), samples_per_spp_(samples_per_spp),
       start_(std::chrono::steady_clock::now()), last_(start_) {}
 
-void ProgressBar::update(uint32_t done, uint32_t total) {
+void ProgressBar::update(uint32_t done, uint32_t total, const std::vector<DeviceReport>& devices) {
     if (!enabled_ || total == 0) return;
     auto now = std::chrono::steady_clock::now();
     if (done < total && drawn_ && now - last_ < std::chrono::milliseconds(100)) return;
@@ -23,8 +24,19 @@ void ProgressBar::update(uint32_t done, uint32_t total) {
     char bar[width + 1];
     for (int k = 0; k < width; ++k) bar[k] = k < filled ? '#' : '.';
     bar[width] = '\0';
-    std::fprintf(stderr, "\r[%s] %3d%% %u/%u spp  %.2f Msamples/s  %.1f s left ", bar,
-                 int(fraction * 100 + 0.5), done, total, rate * 1e-6, left);
+    std::string shares;
+    if (devices.size() > 1) {
+        uint64_t all = 0;
+        for (const DeviceReport& d : devices) all += d.samples;
+        for (const DeviceReport& d : devices) {
+            char share[48];
+            std::snprintf(share, sizeof share, " d%d:%d%%%s", d.index,
+                          all ? int(100.0 * d.samples / all + 0.5) : 0, d.retired ? "(retired)" : "");
+            shares += share;
+        }
+    }
+    std::fprintf(stderr, "\r[%s] %3d%% %u/%u spp  %.2f Msamples/s  %.1f s left%s ", bar,
+                 int(fraction * 100 + 0.5), done, total, rate * 1e-6, left, shares.c_str());
     std::fflush(stderr);
 }
 

@@ -3,6 +3,9 @@
 
 #include <chrono>
 #include <cstdint>
+#include <vector>
+
+#include "render/renderer.h"
 
 namespace mcrt {
 
@@ -10,8 +13,9 @@ class ProgressBar {
 public:
     ProgressBar(bool enabled, uint64_t samples_per_spp);
     ~ProgressBar() { finish(); }  // an error message then starts on a line of its own
-    // done of total samples per pixel; redraws at most ten times a second, and at the end.
-    void update(uint32_t done, uint32_t total);
+    // done of total samples per pixel, and each device's share of the samples; redraws at
+    // most ten times a second, and at the end.
+    void update(uint32_t done, uint32_t total, const std::vector<DeviceReport>& devices);
     void finish();
 
 private:

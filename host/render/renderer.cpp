@@ -2,50 +2,17 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
+#include <mutex>
+#include <thread>
 
 #include "cl/cl_error.h"
 #include "cl/program.h"
 #include "common/error.h"
+#include "render/accumulator.h"
+#include "render/work_queue.h"
 
 namespace mcrt {
-
-Accumulator::Accumulator(int width, int height)
-    : width_(width), height_(height), sum_(3 * size_t(width) * height),
-      sum_sq_(3 * size_t(width) * height) {}
-
-void Accumulator::add_batch(const std::vector<gpu::float4>& sums,
-                            const std::vector<gpu::float4>& sums_sq, uint32_t chunks) {
-    size_t pixels = size_t(width_) * height_;
-    for (size_t p = 0; p < pixels; ++p) {
-        for (uint32_t c = 0; c < chunks; ++c) {
-            const gpu::float4& s = sums[p * chunks + c];
-            const gpu::float4& s2 = sums_sq[p * chunks + c];
-            sum_[3 * p + 0] += s.x;
-            sum_[3 * p + 1] += s.y;
-            sum_[3 * p + 2] += s.z;
-            sum_sq_[3 * p + 0] += s2.x;
-            sum_sq_[3 * p + 1] += s2.y;
-            sum_sq_[3 * p + 2] += s2.z;
-            nan_samples_ += uint64_t(s.w);
-            rays_ += uint64_t(s2.w);
-        }
-    }
-}
-
-Image Accumulator::image(uint32_t spp) const {
-    Image img(width_, height_);
-    img.spp = spp;
-    if (spp == 0) return img;
-    double n = spp;
-    for (size_t k = 0; k < sum_.size(); ++k) {
-        double mean = sum_[k] / n;
-        img.rgb[k] = float(mean);
-        // Variance of the pixel mean: the sample variance (n − 1 denominator) over n.
-        double var = n > 1 ? std::max(0.0, (sum_sq_[k] - sum_[k] * mean) / (n - 1)) / n : 0.0;
-        img.variance[k] = float(var);
-    }
-    return img;
-}
 
 const std::vector<std::string> kEstimators = {
     "hemisphere-uniform", "hemisphere-cosine", "light-area",      "light-solid-angle", "mis",
@@ -91,93 +58,267 @@ static double event_seconds(const cl::Event& event) {
 
 static cl::Buffer device_buffer(const DeviceContext& device, cl_mem_flags flags, size_t bytes,
                                 const char* what) {
-    if (bytes > device.info.max_allocation)
-        throw RuntimeError(std::string(what) + " needs " + std::to_string(bytes) +
-                           " bytes, more than the " + std::to_string(device.info.max_allocation) +
-                           " bytes device '" + device.info.name +
-                           "' can allocate at once (lower --batch)");
     cl_int status = CL_SUCCESS;
     cl::Buffer buffer(device.context, flags, bytes, nullptr, &status);
     CL_CHECK_STATUS(status, (std::string("clCreateBuffer(") + what + ")").c_str());
     return buffer;
 }
 
-RenderResult render(const DeviceContext& device, const GpuSceneData& scene,
-                    const RenderSettings& settings, const ProgressSink& progress) {
-    RenderResult result;
-    const int width = settings.width, height = settings.height;
-    const cl_uint pixels = cl_uint(width) * cl_uint(height);
-    const uint32_t batch = batch_samples_per_pixel(settings.batch, width, height, settings.spp);
-    const uint32_t chunks = (batch + MCRT_SAMPLES_PER_CHUNK - 1) / MCRT_SAMPLES_PER_CHUNK;
+namespace {
 
-    auto t0 = std::chrono::steady_clock::now();
-    cl::Program program = cached_program(device, "render.cl", render_program_options(settings));
-    result.seconds_build = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    cl::Kernel render_kernel = make_kernel(program, "render");
-    cl::Kernel reduce_kernel = make_kernel(program, "reduce_chunks");
+// "D:V" from an environment variable: device index D and a value, for testing and simulation.
+bool device_switch(const char* name, int device_index, double* value) {
+    const char* text = std::getenv(name);
+    if (!text) return false;
+    int d = -1;
+    double v = 0;
+    if (std::sscanf(text, "%d:%lf", &d, &v) != 2 || d != device_index) return false;
+    *value = v;
+    return true;
+}
 
-    GpuSceneBuffers buffers(device, scene);
-    cl::Buffer samples = device_buffer(device, CL_MEM_READ_WRITE,
-                                       size_t(pixels) * batch * sizeof(gpu::float4), "sample buffer");
-    size_t sums_bytes = size_t(pixels) * chunks * sizeof(gpu::float4);
-    cl::Buffer sums = device_buffer(device, CL_MEM_WRITE_ONLY, sums_bytes, "sum buffer");
-    cl::Buffer sums_sq = device_buffer(device, CL_MEM_WRITE_ONLY, sums_bytes, "sum buffer");
+constexpr size_t kGroupSize = 64;
 
-    const cl_float4 sky = {{settings.sky.r, settings.sky.g, settings.sky.b, 0.0f}};
-    CL_CHECK(render_kernel.setArg(0, buffers.nodes));
-    CL_CHECK(render_kernel.setArg(1, buffers.triangles));
-    CL_CHECK(render_kernel.setArg(2, buffers.materials));
-    CL_CHECK(render_kernel.setArg(3, buffers.lights));
-    CL_CHECK(render_kernel.setArg(4, buffers.light_cdf));
-    CL_CHECK(render_kernel.setArg(5, buffers.light_alias));
-    CL_CHECK(render_kernel.setArg(6, buffers.light_count));
-    CL_CHECK(render_kernel.setArg(7, buffers.camera));
-    CL_CHECK(render_kernel.setArg(8, cl_uint(width)));
-    CL_CHECK(render_kernel.setArg(9, cl_uint(height)));
-    CL_CHECK(render_kernel.setArg(10, cl_uint(settings.seed)));
-    CL_CHECK(render_kernel.setArg(11, cl_uint(settings.spp)));
-    CL_CHECK(render_kernel.setArg(12, sky));
-    CL_CHECK(render_kernel.setArg(13, cl_float(settings.ao_distance)));
-    CL_CHECK(render_kernel.setArg(16, samples));
-    CL_CHECK(reduce_kernel.setArg(0, samples));
-    CL_CHECK(reduce_kernel.setArg(2, pixels));
-    CL_CHECK(reduce_kernel.setArg(3, sums));
-    CL_CHECK(reduce_kernel.setArg(4, sums_sq));
+uint64_t round_up(uint64_t n, uint64_t m) { return (n + m - 1) / m * m; }
 
-    Accumulator acc(width, height);
-    std::vector<gpu::float4> host_sums(size_t(pixels) * chunks), host_sums_sq(host_sums.size());
-    DeviceReport report;
-    report.name = device.info.name;
-    for (uint32_t begin = 0; begin < settings.spp; begin += batch) {
-        // Batches start on chunk boundaries: only the last may be shorter.
-        const cl_uint n = std::min(batch, settings.spp - begin);
-        const cl_uint n_chunks = (n + MCRT_SAMPLES_PER_CHUNK - 1) / MCRT_SAMPLES_PER_CHUNK;
-        CL_CHECK(render_kernel.setArg(14, cl_uint(begin)));
-        CL_CHECK(render_kernel.setArg(15, n));
-        CL_CHECK(reduce_kernel.setArg(1, n));
-        cl::Event render_done, reduce_done;
-        CL_CHECK(device.queue.enqueueNDRangeKernel(render_kernel, cl::NullRange,
-                                                   cl::NDRange(size_t(pixels) * n), cl::NullRange,
-                                                   nullptr, &render_done));
-        CL_CHECK(device.queue.enqueueNDRangeKernel(reduce_kernel, cl::NullRange,
-                                                   cl::NDRange(size_t(pixels) * n_chunks),
-                                                   cl::NullRange, nullptr, &reduce_done));
-        size_t bytes = size_t(pixels) * n_chunks * sizeof(gpu::float4);
-        CL_CHECK(device.queue.enqueueReadBuffer(sums, CL_FALSE, 0, bytes, host_sums.data()));
-        CL_CHECK(device.queue.enqueueReadBuffer(sums_sq, CL_TRUE, 0, bytes, host_sums_sq.data()));
-        double busy = event_seconds(render_done) + event_seconds(reduce_done);
-        result.seconds_render += busy;
-        report.seconds_busy += busy;
-        report.samples += uint64_t(pixels) * n;
-        report.batches += 1;
-        acc.add_batch(host_sums, host_sums_sq, n_chunks);
-        if (progress) progress(begin + n, settings.spp);
+// A launch should take about this long: long enough to hide launch overhead, short enough to
+// balance devices and to stop promptly.
+constexpr double kTargetLaunchSeconds = 0.15;
+
+// One device's copy of the scene, its kernels and buffers, and its measured speed.
+class DeviceWorker {
+public:
+    DeviceWorker(const DeviceContext& device, const GpuSceneData& scene,
+                 const RenderSettings& settings, uint64_t fixed_batch_samples)
+        : device_(device), settings_(settings), fixed_batch_(fixed_batch_samples) {
+        report.name = device.info.name;
+        report.index = device.info.index;
+        double v;
+        if (device_switch("MCRT_FAULT_INJECT", device.info.index, &v)) fail_at_launch_ = uint64_t(v);
+        if (device_switch("MCRT_SLOW_DEVICE", device.info.index, &v)) slow_factor_ = std::max(1.0, v);
+
+        cl::Program program = cached_program(device, "render.cl", render_program_options(settings));
+        render_ = make_kernel(program, "render");
+        reduce_ = make_kernel(program, "reduce_chunks");
+        buffers_ = std::make_unique<GpuSceneBuffers>(device, scene);
+
+        // Batch buffers: at most 2^22 samples (64 MiB; a 150 ms launch needs far fewer on today's
+        // devices) or a quarter of an allocation, whichever is less.
+        max_samples_ = std::min<uint64_t>(uint64_t(1) << 22, device.info.max_allocation / 4 / sizeof(gpu::float4));
+        if (fixed_batch_ > 0) max_samples_ = std::max(max_samples_, fixed_batch_);
+        uint64_t needed = buffers_->bytes + max_samples_ * sizeof(gpu::float4) * 3;
+        if (needed > device.info.global_memory)
+            throw RuntimeError("device '" + device.info.name + "' has " +
+                               std::to_string(device.info.global_memory) +
+                               " bytes of memory; the scene and batch buffers need " +
+                               std::to_string(needed));
+        samples_ = device_buffer(device, CL_MEM_READ_WRITE, round_up(max_samples_, kGroupSize) * sizeof(gpu::float4), "samples");
+        // Up to one sum per sample, when spp < one chunk.
+        sums_ = device_buffer(device, CL_MEM_WRITE_ONLY, max_samples_ * sizeof(gpu::float4), "sums");
+        sums_sq_ = device_buffer(device, CL_MEM_WRITE_ONLY, max_samples_ * sizeof(gpu::float4), "sums");
+
+        const cl_float4 sky = {{settings.sky.r, settings.sky.g, settings.sky.b, 0.0f}};
+        CL_CHECK(render_.setArg(0, buffers_->nodes));
+        CL_CHECK(render_.setArg(1, buffers_->triangles));
+        CL_CHECK(render_.setArg(2, buffers_->materials));
+        CL_CHECK(render_.setArg(3, buffers_->lights));
+        CL_CHECK(render_.setArg(4, buffers_->light_cdf));
+        CL_CHECK(render_.setArg(5, buffers_->light_alias));
+        CL_CHECK(render_.setArg(6, buffers_->light_count));
+        CL_CHECK(render_.setArg(7, buffers_->camera));
+        CL_CHECK(render_.setArg(8, cl_uint(settings.width)));
+        CL_CHECK(render_.setArg(9, cl_uint(settings.height)));
+        CL_CHECK(render_.setArg(10, cl_uint(settings.seed)));
+        CL_CHECK(render_.setArg(11, cl_uint(settings.spp)));
+        CL_CHECK(render_.setArg(12, sky));
+        CL_CHECK(render_.setArg(13, cl_float(settings.ao_distance)));
+        CL_CHECK(render_.setArg(18, samples_));
+        CL_CHECK(reduce_.setArg(0, samples_));
+        CL_CHECK(reduce_.setArg(3, sums_));
+        CL_CHECK(reduce_.setArg(4, sums_sq_));
     }
-    result.devices.push_back(report);
-    result.image = acc.image(settings.spp);
+
+    // Samples the next launch should hold: a fixed --batch, else a probe, then what the
+    // measured speed does in kTargetLaunchSeconds.
+    uint64_t target_samples() const {
+        if (fixed_batch_ > 0) return fixed_batch_;
+        if (report.seconds_busy <= 0) return 1024;  // the probe failed to measure anything
+        double rate = double(report.samples) / (report.seconds_busy * slow_factor_);
+        return std::clamp<uint64_t>(uint64_t(rate * kTargetLaunchSeconds), 1024, max_samples_);
+    }
+
+    BatchResult run(const WorkItem& item, const WorkQueue& queue) {
+        const uint32_t sample_begin = item.chunk_begin * MCRT_SAMPLES_PER_CHUNK;
+        const uint32_t sample_end =
+            std::min<uint32_t>(item.chunk_end * MCRT_SAMPLES_PER_CHUNK, settings_.spp);
+        const cl_uint n = sample_end - sample_begin;
+        const uint64_t samples = uint64_t(item.pixel_count()) * n;
+        if (samples > max_samples_)
+            throw RuntimeError("batch of " + std::to_string(samples) + " samples exceeds the " +
+                               std::to_string(max_samples_) + " the buffers of '" + report.name +
+                               "' hold");
+        if (++launches_ == fail_at_launch_)
+            throw ClError("clEnqueueNDRangeKernel (injected by MCRT_FAULT_INJECT)",
+                          CL_OUT_OF_RESOURCES, __FILE__, __LINE__);
+        const cl_uint chunks = item.chunk_count();
+        CL_CHECK(render_.setArg(14, cl_uint(item.pixel_begin)));
+        CL_CHECK(render_.setArg(15, cl_uint(item.pixel_end)));
+        CL_CHECK(render_.setArg(16, cl_uint(sample_begin)));
+        CL_CHECK(render_.setArg(17, n));
+        CL_CHECK(reduce_.setArg(1, n));
+        CL_CHECK(reduce_.setArg(2, cl_uint(item.pixel_count())));
+        cl::Event render_done, reduce_done;
+        // A fixed work-group size: PoCL specialises a kernel per local size, and a NULL local
+        // size lets it pick a new one for each global size (a compile per launch).
+        CL_CHECK(device_.queue.enqueueNDRangeKernel(render_, cl::NullRange,
+                                                    cl::NDRange(round_up(samples, kGroupSize)),
+                                                    cl::NDRange(kGroupSize), nullptr, &render_done));
+        CL_CHECK(device_.queue.enqueueNDRangeKernel(
+            reduce_, cl::NullRange,
+            cl::NDRange(round_up(uint64_t(item.pixel_count()) * chunks, kGroupSize)),
+            cl::NDRange(kGroupSize), nullptr, &reduce_done));
+        BatchResult result;
+        result.item = item;
+        result.sums.resize(size_t(item.pixel_count()) * chunks);
+        result.sums_sq.resize(result.sums.size());
+        size_t bytes = result.sums.size() * sizeof(gpu::float4);
+        CL_CHECK(device_.queue.enqueueReadBuffer(sums_, CL_FALSE, 0, bytes, result.sums.data()));
+        CL_CHECK(device_.queue.enqueueReadBuffer(sums_sq_, CL_TRUE, 0, bytes, result.sums_sq.data()));
+        double busy = event_seconds(render_done) + event_seconds(reduce_done);
+        if (slow_factor_ > 1.0)  // simulate a slower device (MCRT_SLOW_DEVICE)
+            std::this_thread::sleep_for(std::chrono::duration<double>(busy * (slow_factor_ - 1.0)));
+        report.seconds_busy += busy;
+        report.samples += samples;
+        report.batches += 1;
+        (void)queue;
+        return result;
+    }
+
+    DeviceReport report;
+
+private:
+    const DeviceContext& device_;
+    const RenderSettings& settings_;
+    uint64_t fixed_batch_;
+    uint64_t max_samples_ = 0;
+    uint64_t launches_ = 0, fail_at_launch_ = 0;
+    double slow_factor_ = 1.0;
+    cl::Kernel render_, reduce_;
+    std::unique_ptr<GpuSceneBuffers> buffers_;
+    cl::Buffer samples_, sums_, sums_sq_;
+};
+
+}  // namespace
+
+RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuSceneData& scene,
+                    const RenderSettings& settings, const ProgressSink& progress,
+                    const RenderControl& control,
+                    const std::function<void(const std::string&)>& warn) {
+    auto start = std::chrono::steady_clock::now();
+    render_program_options(settings);  // rejects unknown settings before any device work
+    const uint32_t pixels = uint32_t(settings.width) * uint32_t(settings.height);
+    const uint64_t fixed_batch =
+        settings.batch > 0
+            ? uint64_t(pixels) *
+                  batch_samples_per_pixel(settings.batch, settings.width, settings.height, settings.spp)
+            : 0;
+
+    // Set up every device; one that cannot hold the scene is skipped with a warning.
+    std::vector<std::unique_ptr<DeviceWorker>> workers;
+    std::string last_error;
+    for (const DeviceContext* d : devices) {
+        try {
+            workers.push_back(std::make_unique<DeviceWorker>(*d, scene, settings, fixed_batch));
+        } catch (const RuntimeError& e) {
+            if (devices.size() == 1) throw;
+            last_error = e.what();
+            if (warn) warn("skipping device " + std::to_string(d->info.index) + " ('" + d->info.name + "'): " + e.what());
+        }
+    }
+    if (workers.empty()) throw RuntimeError("no device can render this scene: " + last_error);
+
+    RenderResult result;
+    result.seconds_build = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    WorkQueue queue(pixels, settings.spp);
+    Accumulator acc(pixels, settings.spp);
+    std::mutex acc_mutex;
+
+    auto device_reports = [&] {
+        std::vector<DeviceReport> r;
+        for (const auto& w : workers) r.push_back(w->report);
+        return r;
+    };
+    auto device_loop = [&](DeviceWorker& worker, std::optional<WorkItem> item) {
+        for (; item; item = queue.take(worker.target_samples())) {
+            BatchResult r;
+            try {
+                r = worker.run(*item, queue);
+            } catch (const RuntimeError& e) {
+                std::lock_guard<std::mutex> lock(acc_mutex);
+                worker.report.retired = true;
+                if (warn) warn("device " + std::to_string(worker.report.index) + " ('" + worker.report.name + "') failed and is retired; its work is redone on the other devices: " + e.what());
+                queue.give_back(*item);
+                return;
+            }
+            std::lock_guard<std::mutex> lock(acc_mutex);
+            acc.submit(std::move(r));
+            queue.done(*item);
+        }
+    };
+    // Every device starts with a probe launch handed out here, so each one measures its speed
+    // and none is starved by a faster one that starts first; the probes leave most of the work
+    // to the dynamic phase.
+    const uint64_t total_samples = uint64_t(pixels) * settings.spp;
+    const uint64_t probe = std::clamp<uint64_t>(total_samples / (8 * workers.size()), 1024, 1 << 16);
+    std::vector<std::thread> threads;
+    for (auto& w : workers)
+        threads.emplace_back(device_loop, std::ref(*w),
+                             queue.take(fixed_batch > 0 ? fixed_batch : probe));
+
+    // Watch the clock, the interrupt flag and the progress until the devices are done.
+    auto finished = [&] {
+        for (const auto& w : workers)
+            if (!w->report.retired) return false;
+        return true;
+    };
+    for (;;) {
+        {
+            std::lock_guard<std::mutex> lock(acc_mutex);
+            if (progress) progress(acc.committed_spp(), settings.spp, device_reports());
+            if (acc.committed_spp() >= settings.spp || finished()) break;
+        }
+        double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (result.stopped_by.empty() && control.time_limit > 0 && elapsed >= control.time_limit) {
+            result.stopped_by = "time limit";
+            queue.stop();
+        }
+        if (result.stopped_by.empty() && control.interrupted && *control.interrupted) {
+            result.stopped_by = "interrupt";
+            queue.stop();
+        }
+        if (queue.stopped()) {
+            // Wait for the threads: hand-out has stopped, in-flight work drains.
+            break;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    for (std::thread& t : threads) t.join();
+
+    if (acc.committed_spp() == 0 || (result.stopped_by.empty() && acc.committed_spp() < settings.spp))
+        throw RuntimeError("every device failed; no image was completed");
+    if (progress) progress(acc.committed_spp(), settings.spp, device_reports());
+    result.spp = acc.committed_spp();
+    result.image = acc.image(settings.width, settings.height);
     result.nan_samples = acc.nan_samples();
     result.rays = acc.rays();
+    result.devices = device_reports();
+    for (const DeviceReport& d : result.devices) result.seconds_render += d.seconds_busy;
     return result;
+}
+
+RenderResult render(const DeviceContext& device, const GpuSceneData& scene,
+                    const RenderSettings& settings) {
+    return render(std::vector<const DeviceContext*>{&device}, scene, settings);
 }
 
 }  // namespace mcrt

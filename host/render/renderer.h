@@ -1,6 +1,7 @@
 // Rendering a scene on a device: batching, the render and reduction kernels, accumulation.
 #pragma once
 
+#include <csignal>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -35,52 +36,54 @@ extern const std::vector<std::string> kEstimators;
 
 struct DeviceReport {
     std::string name;
+    int index = 0;            // as `mcrt devices` lists it
     uint64_t samples = 0;
     uint64_t batches = 0;
     double seconds_busy = 0;  // kernel time from profiling events
+    bool retired = false;     // failed during the render; its work was redone elsewhere
 };
 
 struct RenderResult {
     Image image;
-    uint64_t nan_samples = 0;  // non-finite samples, left out of the image
-    uint64_t rays = 0;         // camera and shadow rays traced
-    double seconds_render = 0; // kernel time (profiling events)
-    double seconds_build = 0;  // kernel compilation
+    uint32_t spp = 0;            // samples per pixel in the image (fewer if stopped early)
+    std::string stopped_by;      // "", "time limit" or "interrupt"
+    uint64_t nan_samples = 0;    // non-finite samples, left out of the image
+    uint64_t rays = 0;           // camera and shadow rays traced
+    double seconds_render = 0;   // kernel time summed over devices (profiling events)
+    double seconds_build = 0;    // kernel compilation and scene upload
     std::vector<DeviceReport> devices;
 };
 
-// Progress: samples per pixel done so far, of the total.
-using ProgressSink = std::function<void(uint32_t done, uint32_t total)>;
+// Progress: samples per pixel in the image so far, of the total, and each device's share.
+using ProgressSink =
+    std::function<void(uint32_t done, uint32_t total, const std::vector<DeviceReport>& devices)>;
 
-// Accumulates per-chunk sums in double precision, in the order they are added; callers add
-// batches in sample-index order, so the result does not depend on how samples were batched.
-class Accumulator {
-public:
-    Accumulator(int width, int height);
-    // sums / sums_sq: pixels × chunks float4 as reduce_chunks writes them.
-    void add_batch(const std::vector<gpu::float4>& sums, const std::vector<gpu::float4>& sums_sq,
-                   uint32_t chunks);
-    Image image(uint32_t spp) const;
-    uint64_t nan_samples() const { return nan_samples_; }
-    uint64_t rays() const { return rays_; }
-
-private:
-    int width_, height_;
-    std::vector<double> sum_, sum_sq_;  // 3 per pixel
-    uint64_t nan_samples_ = 0, rays_ = 0;
+// How a render may end early: a time limit (0 = none) and a flag set from a signal handler.
+struct RenderControl {
+    double time_limit = 0;
+    const volatile std::sig_atomic_t* interrupted = nullptr;
 };
 
 // The -D options of the render program for these settings (throws InputError for an unknown
 // estimator).
 std::string render_program_options(const RenderSettings& settings);
 
-// Renders on one device. Throws InputError for settings it cannot honour, RuntimeError /
-// ClError for device failures.
-RenderResult render(const DeviceContext& device, const GpuSceneData& scene,
-                    const RenderSettings& settings, const ProgressSink& progress = {});
+// Renders on every device at once: work is handed out dynamically, each device's launches sized
+// to take about 150 ms; a device that fails is retired with a warning and its work redone on the
+// others. The image is bitwise identical whatever the devices, batch sizes and timing (for
+// devices that round identically). Throws InputError for settings it cannot honour,
+// RuntimeError when no device can render.
+RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuSceneData& scene,
+                    const RenderSettings& settings, const ProgressSink& progress = {},
+                    const RenderControl& control = {},
+                    const std::function<void(const std::string&)>& warn = {});
 
-// Samples per pixel per launch: `requested` rounded up to whole chunks, or, when 0, about
-// 2^22 samples per launch.
+// One device, no early stop.
+RenderResult render(const DeviceContext& device, const GpuSceneData& scene,
+                    const RenderSettings& settings);
+
+// Samples per pixel per launch when --batch is given: rounded up to whole chunks, at most spp
+// rounded up.
 uint32_t batch_samples_per_pixel(uint32_t requested, int width, int height, uint32_t spp);
 
 }  // namespace mcrt

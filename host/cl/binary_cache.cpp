@@ -1,0 +1,278 @@
+// Compiled program binaries on disk, keyed by device, driver, source and options.
+#include "cl/binary_cache.h"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <system_error>
+#include <vector>
+
+#include "cl/cl_error.h"
+#include "cl/program.h"
+#include "common/atomic_file.h"
+
+namespace mcrt {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr char kMagic[8] = {'M', 'C', 'R', 'T', 'B', 'I', 'N', '1'};
+constexpr size_t kHeaderBytes = 40;
+
+// FNV-1a, 64 bits (Fowler, Noll, Vo; http://www.isthe.com/chongo/tech/comp/fnv/).
+uint64_t fnv1a_64(const unsigned char* data, size_t n) {
+    uint64_t h = 14695981039346656037ull;
+    for (size_t i = 0; i < n; ++i) {
+        h ^= data[i];
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+uint64_t load_le64(const unsigned char* p) {
+    uint64_t v = 0;
+    for (int i = 7; i >= 0; --i) v = (v << 8) | p[i];
+    return v;
+}
+
+void store_le64(unsigned char* p, uint64_t v) {
+    for (int i = 0; i < 8; ++i) p[i] = (unsigned char)(v >> (8 * i));
+}
+
+// MurmurHash64A (Austin Appleby, public domain), reading bytes little-endian on every host.
+uint64_t murmur64a(const unsigned char* data, size_t n, uint64_t seed) {
+    const uint64_t m = 0xc6a4a7935bd1e995ull;
+    const int r = 47;
+    uint64_t h = seed ^ (n * m);
+    size_t blocks = n / 8;
+    for (size_t i = 0; i < blocks; ++i) {
+        uint64_t k = load_le64(data + 8 * i);
+        k *= m;
+        k ^= k >> r;
+        k *= m;
+        h ^= k;
+        h *= m;
+    }
+    const unsigned char* tail = data + 8 * blocks;
+    switch (n & 7) {
+        case 7:
+            h ^= uint64_t(tail[6]) << 48;
+            [[fallthrough]];
+        case 6:
+            h ^= uint64_t(tail[5]) << 40;
+            [[fallthrough]];
+        case 5:
+            h ^= uint64_t(tail[4]) << 32;
+            [[fallthrough]];
+        case 4:
+            h ^= uint64_t(tail[3]) << 24;
+            [[fallthrough]];
+        case 3:
+            h ^= uint64_t(tail[2]) << 16;
+            [[fallthrough]];
+        case 2:
+            h ^= uint64_t(tail[1]) << 8;
+            [[fallthrough]];
+        case 1:
+            h ^= uint64_t(tail[0]);
+            h *= m;
+    }
+    h ^= h >> r;
+    h *= m;
+    h ^= h >> r;
+    return h;
+}
+
+uint64_t payload_hash(const unsigned char* data, size_t n) {
+    return murmur64a(data, n, 0x6d637274'62696e31ull);  // "mcrtbin1"
+}
+
+void append_field(std::string& out, const char* name, const std::string& value) {
+    out += name;
+    out += '=';
+    out += std::to_string(value.size());
+    out += ':';
+    out += value;
+    out += '\n';
+}
+
+bool cache_disabled() {
+    const char* off = std::getenv("MCRT_NO_KERNEL_CACHE");
+    return off && *off && std::strcmp(off, "0") != 0;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The payload of a valid entry for `key`, or an empty vector with `why` set.
+std::vector<unsigned char> read_entry(const std::string& path, const BinaryCacheKey& key,
+                                      std::string& why) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return {};  // a plain miss, not a rejection
+    std::vector<unsigned char> file((std::istreambuf_iterator<char>(in)),
+                                    std::istreambuf_iterator<char>());
+    if (in.bad()) {
+        why = "read error";
+        return {};
+    }
+    if (file.size() < kHeaderBytes) {
+        why = "truncated header";
+        return {};
+    }
+    if (std::memcmp(file.data(), kMagic, sizeof kMagic) != 0) {
+        why = "wrong magic";
+        return {};
+    }
+    if (load_le64(&file[8]) != key.hi || load_le64(&file[16]) != key.lo) {
+        why = "wrong key";
+        return {};
+    }
+    uint64_t size = load_le64(&file[24]);
+    if (size == 0 || size != file.size() - kHeaderBytes) {
+        why = "payload size " + std::to_string(size) + " but " +
+              std::to_string(file.size() - kHeaderBytes) + " bytes present";
+        return {};
+    }
+    if (load_le64(&file[32]) != payload_hash(&file[kHeaderBytes], size)) {
+        why = "payload hash mismatch";
+        return {};
+    }
+    return std::vector<unsigned char>(file.begin() + kHeaderBytes, file.end());
+}
+
+// The built program from `binary`, or a null program with `why` set; never throws.
+cl::Program program_from_binary(const cl::Context& context, const cl::Device& device,
+                                const std::vector<unsigned char>& binary,
+                                const std::string& options, std::string& why) {
+    cl_int status = CL_SUCCESS;
+    std::vector<cl_int> binary_status;
+    cl::Program program(context, std::vector<cl::Device>{device}, cl::Program::Binaries{binary},
+                        &binary_status, &status);
+    if (status != CL_SUCCESS) {
+        why = "clCreateProgramWithBinary: " + cl_error_name(status);
+        return cl::Program();
+    }
+    // clBuildProgram is required for a program created from a binary, too (OpenCL 1.2 §5.6.2).
+    status = program.build(std::vector<cl::Device>{device}, options.c_str());
+    if (status != CL_SUCCESS) {
+        why = "clBuildProgram from binary: " + cl_error_name(status);
+        return cl::Program();
+    }
+    return program;
+}
+
+// The binary of `program` for `device`, empty when the driver gives none.
+std::vector<unsigned char> program_binary(const cl::Program& program, const cl::Device& device) {
+    std::vector<cl::Device> devices;
+    std::vector<std::vector<unsigned char>> binaries;
+    if (program.getInfo(CL_PROGRAM_DEVICES, &devices) != CL_SUCCESS) return {};
+    if (program.getInfo(CL_PROGRAM_BINARIES, &binaries) != CL_SUCCESS) return {};
+    for (size_t i = 0; i < devices.size() && i < binaries.size(); ++i)
+        if (devices[i]() == device()) return std::move(binaries[i]);
+    return {};
+}
+
+}  // namespace
+
+std::string BinaryCacheKey::hex() const {
+    char text[33];
+    std::snprintf(text, sizeof text, "%016llx%016llx", (unsigned long long)hi,
+                  (unsigned long long)lo);
+    return text;
+}
+
+BinaryCacheKey binary_cache_key(const DeviceInfo& device, const std::string& source,
+                                const std::string& options) {
+    std::string canonical = "mcrt kernel binary\n";
+    append_field(canonical, "format", std::to_string(kBinaryCacheFormatVersion));
+    append_field(canonical, "platform", device.platform_name);
+    append_field(canonical, "device", device.name);
+    append_field(canonical, "device_version", device.version);
+    append_field(canonical, "driver_version", device.driver_version);
+    append_field(canonical, "options", options);
+    append_field(canonical, "source", source);
+    const auto* bytes = reinterpret_cast<const unsigned char*>(canonical.data());
+    return {fnv1a_64(bytes, canonical.size()),
+            murmur64a(bytes, canonical.size(), 0x9e3779b97f4a7c15ull)};
+}
+
+std::string binary_cache_directory() {
+    if (cache_disabled()) return {};
+    if (const char* dir = std::getenv("MCRT_CACHE_DIR"); dir && *dir) return dir;
+    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
+        return std::string(xdg) + "/mcrt/kernels";
+    if (const char* home = std::getenv("HOME"); home && *home)
+        return std::string(home) + "/.cache/mcrt/kernels";
+    return {};
+}
+
+std::string store_binary_cache_entry(const std::string& path, const BinaryCacheKey& key,
+                                     const std::vector<unsigned char>& binary) {
+    if (binary.empty()) return "the driver returned no binary";
+    try {
+        std::error_code ec;
+        fs::create_directories(fs::path(path).parent_path(), ec);
+        if (ec)
+            return "cannot create " + fs::path(path).parent_path().string() + ": " + ec.message();
+        unsigned char header[kHeaderBytes];
+        std::memcpy(header, kMagic, sizeof kMagic);
+        store_le64(header + 8, key.hi);
+        store_le64(header + 16, key.lo);
+        store_le64(header + 24, binary.size());
+        store_le64(header + 32, payload_hash(binary.data(), binary.size()));
+        write_atomically(path, [&](const std::string& temporary) {
+            std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+            out.write(reinterpret_cast<const char*>(header), sizeof header);
+            out.write(reinterpret_cast<const char*>(binary.data()), std::streamsize(binary.size()));
+            out.close();
+            if (!out) throw RuntimeError(temporary + ": cannot write");
+        });
+        return {};
+    } catch (const std::exception& e) {
+        return e.what();
+    }
+}
+
+cl::Program build_program_cached(const cl::Context& context, const cl::Device& device,
+                                 const DeviceInfo& info, const std::string& source,
+                                 const std::string& options, BuildReport* report) {
+    const auto t0 = std::chrono::steady_clock::now();
+    BuildReport local;
+    BuildReport& r = report ? *report : local;
+    r = BuildReport();
+
+    const std::string directory = binary_cache_directory();
+    if (directory.empty()) {
+        cl::Program program = build_program(context, device, source, options);
+        r.seconds = seconds_since(t0);
+        return program;
+    }
+
+    const BinaryCacheKey key = binary_cache_key(info, source, options);
+    r.path = (fs::path(directory) / (key.hex() + ".bin")).string();
+
+    // Hit: a valid entry the driver accepts.
+    std::vector<unsigned char> binary = read_entry(r.path, key, r.rejected);
+    if (!binary.empty()) {
+        cl::Program program = program_from_binary(context, device, binary, options, r.rejected);
+        if (program()) {
+            r.cache_hit = true;
+            r.seconds = seconds_since(t0);
+            return program;
+        }
+    }
+
+    // Miss or rejected entry: build from source (a failing build throws) and store the binary.
+    cl::Program program = build_program(context, device, source, options);
+    r.store_error = store_binary_cache_entry(r.path, key, program_binary(program, device));
+    r.seconds = seconds_since(t0);
+    return program;
+}
+
+}  // namespace mcrt

@@ -1,0 +1,355 @@
+// The on-disk kernel binary cache: hits, misses, keys, and that it never fails a build.
+#include <catch2/catch.hpp>
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cl/binary_cache.h"
+#include "cl/cl_error.h"
+#include "cl/program.h"
+#include "device_support.h"
+
+using namespace mcrt;
+using mcrt::test::first_device;
+namespace fs = std::filesystem;
+
+namespace {
+
+// Sets environment variables for one test case and restores the previous values on exit.
+class ScopedEnv {
+  public:
+    void set(const char* name, const std::string& value) {
+        remember(name);
+        setenv(name, value.c_str(), 1);
+    }
+    void unset(const char* name) {
+        remember(name);
+        unsetenv(name);
+    }
+    ~ScopedEnv() {
+        for (auto it = saved_.rbegin(); it != saved_.rend(); ++it) {
+            if (it->second)
+                setenv(it->first.c_str(), it->second->c_str(), 1);
+            else
+                unsetenv(it->first.c_str());
+        }
+    }
+
+  private:
+    void remember(const char* name) {
+        const char* old = std::getenv(name);
+        saved_.emplace_back(name, old ? std::optional<std::string>(old) : std::nullopt);
+    }
+    std::vector<std::pair<std::string, std::optional<std::string>>> saved_;
+};
+
+// A fresh cache directory, removed at the end of the test; MCRT_CACHE_DIR points at it.
+struct TempCache {
+    ScopedEnv env;
+    fs::path dir;
+    TempCache() {
+        dir = fs::temp_directory_path() / ("mcrt_binary_cache_test-" + std::to_string(::getpid()) +
+                                           "-" + std::to_string(counter()++));
+        fs::remove_all(dir);
+        env.set("MCRT_CACHE_DIR", dir.string());
+        env.unset("MCRT_NO_KERNEL_CACHE");
+    }
+    ~TempCache() {
+        std::error_code ec;
+        fs::permissions(dir, fs::perms::owner_all, fs::perm_options::add, ec);
+        fs::remove_all(dir, ec);
+    }
+    static int& counter() {
+        static int n = 0;
+        return n;
+    }
+    std::vector<fs::path> files() const {
+        std::vector<fs::path> out;
+        std::error_code ec;
+        if (!fs::is_directory(dir, ec)) return out;
+        for (const auto& entry : fs::directory_iterator(dir)) out.push_back(entry.path());
+        return out;
+    }
+};
+
+// x[i] = i * SCALE + OFFSET: the options change the result, so a binary built with other
+// options would show in the output.
+const std::string kSource =
+    "kernel void affine(global float* x) {\n"
+    "    size_t i = get_global_id(0);\n"
+    "    x[i] = (float)i * SCALE + OFFSET;\n"
+    "}\n";
+const std::string kOptions = "-D SCALE=2.0f -D OFFSET=1.0f";
+
+// Runs `affine` over 16 items and checks x[i] == i * scale + offset.
+void check_runs(const DeviceContext& device, const cl::Program& program, float scale,
+                float offset) {
+    cl::Kernel kernel = make_kernel(program, "affine");
+    cl_int status = CL_SUCCESS;
+    const size_t n = 16;
+    cl::Buffer x(device.context, CL_MEM_WRITE_ONLY, n * sizeof(cl_float), nullptr, &status);
+    REQUIRE(status == CL_SUCCESS);
+    CL_CHECK(kernel.setArg(0, x));
+    CL_CHECK(device.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(n)));
+    std::vector<cl_float> got(n);
+    CL_CHECK(device.queue.enqueueReadBuffer(x, CL_TRUE, 0, n * sizeof(cl_float), got.data()));
+    for (size_t i = 0; i < n; ++i) CHECK(got[i] == float(i) * scale + offset);
+}
+
+cl::Program build(const DeviceContext& device, const std::string& source,
+                  const std::string& options, BuildReport& report) {
+    return build_program_cached(device.context, device.info.device, device.info, source, options,
+                                &report);
+}
+
+std::vector<char> read_bytes(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::vector<char>((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
+}
+
+void write_bytes(const fs::path& path, const std::vector<char>& bytes) {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+}  // namespace
+
+TEST_CASE("the cache directory follows MCRT_CACHE_DIR, XDG_CACHE_HOME, then HOME", "[cache]") {
+    ScopedEnv env;
+    env.unset("MCRT_NO_KERNEL_CACHE");
+    env.set("MCRT_CACHE_DIR", "/tmp/a");
+    env.set("XDG_CACHE_HOME", "/tmp/xdg");
+    env.set("HOME", "/tmp/home");
+    CHECK(binary_cache_directory() == "/tmp/a");
+    env.unset("MCRT_CACHE_DIR");
+    CHECK(binary_cache_directory() == "/tmp/xdg/mcrt/kernels");
+    env.unset("XDG_CACHE_HOME");
+    CHECK(binary_cache_directory() == "/tmp/home/.cache/mcrt/kernels");
+    env.set("MCRT_NO_KERNEL_CACHE", "1");
+    CHECK(binary_cache_directory().empty());
+}
+
+TEST_CASE("the key covers device, driver, source, options; its file name is hex", "[cache]") {
+    DeviceInfo info;
+    info.platform_name = "P";
+    info.name = "D";
+    info.version = "OpenCL 1.2";
+    info.driver_version = "1.0";
+    BinaryCacheKey key = binary_cache_key(info, kSource, kOptions);
+    CHECK(key == binary_cache_key(info, kSource, kOptions));
+    CHECK(key.hex().size() == 32);
+    CHECK(key.hex().find_first_not_of("0123456789abcdef") == std::string::npos);
+    CHECK(key != binary_cache_key(info, kSource + " ", kOptions));
+    CHECK(key != binary_cache_key(info, kSource, kOptions + " "));
+    // Moving text from one field to the next changes the key (fields are length-prefixed).
+    CHECK(binary_cache_key(info, "ab", "c") != binary_cache_key(info, "a", "bc"));
+    for (std::string DeviceInfo::*field : {&DeviceInfo::platform_name, &DeviceInfo::name,
+                                           &DeviceInfo::version, &DeviceInfo::driver_version}) {
+        DeviceInfo other = info;
+        other.*field += "x";
+        CHECK(key != binary_cache_key(other, kSource, kOptions));
+    }
+}
+
+TEST_CASE("a first build writes one entry, the second is a hit", "[cache]") {
+    DeviceContext device = first_device();
+    TempCache cache;
+    BuildReport first, second;
+    cl::Program a = build(device, kSource, kOptions, first);
+    CHECK_FALSE(first.cache_hit);
+    CHECK(first.store_error.empty());
+    CHECK(first.rejected.empty());
+    REQUIRE(cache.files().size() == 1);
+    CHECK(cache.files()[0] == fs::path(first.path));
+    CHECK(fs::path(first.path).extension() == ".bin");
+    check_runs(device, a, 2.0f, 1.0f);
+
+    cl::Program b = build(device, kSource, kOptions, second);
+    CHECK(second.cache_hit);
+    CHECK(second.path == first.path);
+    CHECK(cache.files().size() == 1);
+    check_runs(device, b, 2.0f, 1.0f);
+
+    std::vector<char> bytes = read_bytes(first.path);
+    REQUIRE(bytes.size() > 40);
+    CHECK(std::string(bytes.data(), 8) == "MCRTBIN1");
+}
+
+TEST_CASE("other options or another source give another entry", "[cache]") {
+    DeviceContext device = first_device();
+    TempCache cache;
+    BuildReport r1, r2, r3, r4;
+    build(device, kSource, kOptions, r1);
+    cl::Program p2 = build(device, kSource, "-D SCALE=3.0f -D OFFSET=-1.0f", r2);
+    cl::Program p3 = build(device, "// another source\n" + kSource, kOptions, r3);
+    CHECK_FALSE(r2.cache_hit);
+    CHECK_FALSE(r3.cache_hit);
+    CHECK(r1.path != r2.path);
+    CHECK(r1.path != r3.path);
+    CHECK(r2.path != r3.path);
+    CHECK(cache.files().size() == 3);
+    check_runs(device, p2, 3.0f, -1.0f);
+    check_runs(device, p3, 2.0f, 1.0f);
+
+    // Each is then a hit on its own entry, with its own options' result.
+    cl::Program p4 = build(device, kSource, "-D SCALE=3.0f -D OFFSET=-1.0f", r4);
+    CHECK(r4.cache_hit);
+    CHECK(r4.path == r2.path);
+    check_runs(device, p4, 3.0f, -1.0f);
+}
+
+TEST_CASE("a corrupt entry is rebuilt from source and replaced", "[cache]") {
+    DeviceContext device = first_device();
+    TempCache cache;
+    BuildReport first;
+    build(device, kSource, kOptions, first);
+    const std::vector<char> valid = read_bytes(first.path);
+    REQUIRE(valid.size() > 64);
+
+    // Each corruption, then a build: not a hit, the entry is valid again and the program runs.
+    auto corrupted = [&](std::vector<char> bytes) {
+        write_bytes(first.path, bytes);
+        BuildReport rebuilt, again;
+        cl::Program program = build(device, kSource, kOptions, rebuilt);
+        CHECK_FALSE(rebuilt.cache_hit);
+        CHECK_FALSE(rebuilt.rejected.empty());
+        CHECK(rebuilt.store_error.empty());
+        check_runs(device, program, 2.0f, 1.0f);
+        CHECK(cache.files().size() == 1);
+        cl::Program reloaded = build(device, kSource, kOptions, again);
+        CHECK(again.cache_hit);
+        check_runs(device, reloaded, 2.0f, 1.0f);
+        return rebuilt.rejected;
+    };
+
+    SECTION("truncated payload") {
+        std::vector<char> bytes(valid.begin(), valid.begin() + valid.size() / 2);
+        CHECK_THAT(corrupted(bytes), Catch::StartsWith("payload size"));
+    }
+    SECTION("truncated header") {
+        std::vector<char> bytes(valid.begin(), valid.begin() + 20);
+        CHECK(corrupted(bytes) == "truncated header");
+    }
+    SECTION("empty file") { CHECK(corrupted({}) == "truncated header"); }
+    SECTION("flipped payload bytes") {
+        std::vector<char> bytes = valid;
+        for (size_t i = 40; i < bytes.size(); i += 97) bytes[i] = char(bytes[i] ^ 0x5a);
+        CHECK(corrupted(bytes) == "payload hash mismatch");
+    }
+    SECTION("wrong magic") {
+        std::vector<char> bytes = valid;
+        bytes[7] = '9';
+        CHECK(corrupted(bytes) == "wrong magic");
+    }
+    SECTION("another key's entry under this name") {
+        std::vector<char> bytes = valid;
+        bytes[8] = char(bytes[8] ^ 1);
+        CHECK(corrupted(bytes) == "wrong key");
+    }
+    SECTION("a well-formed entry whose binary the driver rejects") {
+        BinaryCacheKey key = binary_cache_key(device.info, kSource, kOptions);
+        std::vector<unsigned char> garbage(4096);
+        for (size_t i = 0; i < garbage.size(); ++i) garbage[i] = (unsigned char)(i * 131 + 7);
+        REQUIRE(store_binary_cache_entry(first.path, key, garbage).empty());
+        // PoCL refuses it at clCreateProgramWithBinary (CL_INVALID_BINARY), others may at build.
+        CHECK_THAT(corrupted(read_bytes(first.path)), Catch::StartsWith("cl"));
+    }
+}
+
+TEST_CASE("an unwritable cache directory does not fail the build", "[cache]") {
+    DeviceContext device = first_device();
+    TempCache cache;
+    BuildReport report;
+
+    SECTION("read-only directory") {
+        fs::create_directories(cache.dir);
+        fs::permissions(cache.dir, fs::perms::owner_read | fs::perms::owner_exec);
+        cl::Program program = build(device, kSource, kOptions, report);
+        check_runs(device, program, 2.0f, 1.0f);
+        CHECK_FALSE(report.cache_hit);
+        // root writes anyway; anyone else is refused, and told so in the report.
+        if (::geteuid() != 0) {
+            CHECK(cache.files().empty());
+            CHECK_FALSE(report.store_error.empty());
+        }
+    }
+    SECTION("a file where the directory should be") {
+        fs::create_directories(cache.dir);
+        std::ofstream(cache.dir / "not-a-directory") << "x";
+        cache.env.set("MCRT_CACHE_DIR", (cache.dir / "not-a-directory" / "kernels").string());
+        cl::Program program = build(device, kSource, kOptions, report);
+        check_runs(device, program, 2.0f, 1.0f);
+        CHECK_FALSE(report.cache_hit);
+        CHECK_FALSE(report.store_error.empty());
+        CHECK(cache.files().size() == 1);  // only the plain file
+    }
+}
+
+TEST_CASE("the cache creates its directory tree", "[cache]") {
+    DeviceContext device = first_device();
+    TempCache cache;
+    fs::path nested = cache.dir / "a" / "b" / "kernels";
+    cache.env.set("MCRT_CACHE_DIR", nested.string());
+    BuildReport report;
+    build(device, kSource, kOptions, report);
+    CHECK(report.store_error.empty());
+    CHECK(fs::exists(report.path));
+    CHECK(fs::path(report.path).parent_path() == nested);
+}
+
+TEST_CASE("MCRT_NO_KERNEL_CACHE=1 builds from source and writes nothing", "[cache]") {
+    DeviceContext device = first_device();
+    TempCache cache;
+    cache.env.set("MCRT_NO_KERNEL_CACHE", "1");
+    BuildReport first, second;
+    cl::Program a = build(device, kSource, kOptions, first);
+    cl::Program b = build(device, kSource, kOptions, second);
+    CHECK_FALSE(first.cache_hit);
+    CHECK_FALSE(second.cache_hit);
+    CHECK(second.path.empty());
+    CHECK_FALSE(fs::exists(cache.dir));
+    check_runs(device, b, 2.0f, 1.0f);
+}
+
+TEST_CASE("a broken source still throws with the build log, and is not cached", "[cache]") {
+    DeviceContext device = first_device();
+    TempCache cache;
+    std::string source =
+        "#line 1 \"broken.cl\"\nkernel void k(global float* x) {\n"
+        "    x[0] = undefined_name;\n}\n";
+    for (int attempt = 0; attempt < 2; ++attempt) {
+        try {
+            BuildReport report;
+            build(device, source, "", report);
+            FAIL("the broken kernel built");
+        } catch (const RuntimeError& e) {
+            std::string what = e.what();
+            CHECK(what.find("kernel build failed") != std::string::npos);
+            CHECK(what.find("undefined_name") != std::string::npos);
+            CHECK(what.find("broken.cl:2") != std::string::npos);
+        }
+    }
+    CHECK(cache.files().empty());
+}
+
+TEST_CASE("cached_program stores the render kernel in the binary cache", "[cache]") {
+    // On PoCL, cached_program leaves caching to PoCL's own cache unless it is turned off.
+    setenv("POCL_KERNEL_CACHE", "0", 1);
+    DeviceContext device = first_device();
+    TempCache cache;
+    cl::Program program = cached_program(device, "render.cl", "-D ESTIMATOR_LIGHT_AREA");
+    unsetenv("POCL_KERNEL_CACHE");
+    CHECK(program());
+    CHECK(cache.files().size() == 1);
+    BuildReport report;
+    build(device, kernel_source("render.cl"), "-D ESTIMATOR_LIGHT_AREA", report);
+    CHECK(report.cache_hit);
+}
