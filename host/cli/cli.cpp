@@ -1,5 +1,6 @@
 #include "cli/cli.h"
 
+#include <array>
 #include <chrono>
 #include <csignal>
 #include <cmath>
@@ -254,6 +255,16 @@ int run_render(const RenderOptions& o) {
             {"bvh", {{"nodes", bvh.nodes.size()}, {"sah_cost", bvh.stats.sah_cost},
                      {"depth", bvh.stats.depth}, {"bytes", bvh.stats.bytes}}},
         };
+        // Image-wide means, so that scripts can compare renders without reading EXR.
+        std::array<double, 3> mean{}, mean_variance{};
+        size_t pixels = size_t(o.width) * o.height;
+        for (size_t p = 0; p < pixels; ++p)
+            for (int c = 0; c < 3; ++c) {
+                mean[c] += result.image.rgb[3 * p + c] / double(pixels);
+                mean_variance[c] += result.image.variance[3 * p + c] / double(pixels);
+            }
+        j["image_mean"] = mean;
+        j["image_mean_variance"] = mean_variance;
         nlohmann::json devices_json = nlohmann::json::array();
         for (const DeviceReport& d : result.devices)
             devices_json.push_back({{"name", d.name}, {"index", d.index}, {"samples", d.samples},
