@@ -53,4 +53,6 @@ inline bool intersect_triangle(const Ray* r, float4 p0, float4 p1, float4 p2, fl
     return true;
 }
 
+/* Contraction is harmless, and faster, in the rest of the program. */
+#pragma OPENCL FP_CONTRACT ON
 #endif
