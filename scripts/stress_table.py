@@ -1,0 +1,223 @@
+#!/usr/bin/python3
+"""Stability where methods fail: the error of each direct estimator on each stress scene.
+
+For every scene of scenes/stress × direct estimator (× light selection: `power`, or all three on
+the scenes about selection), renders K independent seeds with the mcrt executable at a fixed spp
+and measures, from the K EXRs and stats JSONs:
+
+  m_k      image mean of render k: the mean over all pixels and the R, G, B channels;
+  RSE      relative standard error at equal samples: std(m_1..m_K, ddof=1) / mean(m_1..m_K),
+           the relative error of one render's image mean;
+  RSE_t    the same at equal time: RSE × √(t / t_ref), t the least seconds_render (device time,
+           without kernel build) of the row's K renders (the one least disturbed by other load),
+           t_ref the median of t over the scene's rows. Error falls as 1/√time, so this is the RSE the estimator would reach in the
+           time t_ref: the efficiency 1/(σ²·t) (PBRT 3rd ed. 13.7) as a relative error;
+  px RSE   relative per-pixel error from the EXRs' variance layer: √(mean of the variance of
+           the pixel means over pixels, channels and renders) / (mean of the pixel means);
+  NaN      total nan_samples of the K stats JSONs (non-finite samples the renderer dropped).
+
+An RSE of "∞" means every render's image mean was 0 (no sample found light). Prints Markdown
+tables: RSE and RSE_t as an estimator × scene matrix, then every measurement.
+
+The EXRs are read here (ZIP or uncompressed scanline float EXR, as mcrt writes them) with zlib
+and numpy: Debian 12 has no Python OpenEXR binding.
+
+Usage: scripts/stress_table.py [--mcrt build/mcrt] [--seeds 8] [--spp 64] [--size 128]
+                               [--scenes NAME ...] [--keep DIR]
+"""
+
+import argparse
+import json
+import math
+import statistics
+import struct
+import subprocess
+import sys
+import tempfile
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+SCENES = ["tiny-bright-light", "near-light", "grazing-light", "light-facing-away", "many-lights",
+          "degenerate-emitters", "reflecting-emitters"]
+# Scenes about light selection: every selection; the others use power.
+SELECTION_SCENES = {"light-facing-away", "many-lights"}
+# (label, estimator, extra arguments); the direct-light estimators of DESIGN.md.
+ESTIMATORS = [("light-area", "light-area", []),
+              ("light-solid-angle", "light-solid-angle", []),
+              ("mis (balance)", "mis", ["--mis-heuristic", "balance"]),
+              ("mis (power)", "mis", ["--mis-heuristic", "power"]),
+              ("hemisphere-uniform", "hemisphere-uniform", []),
+              ("hemisphere-cosine", "hemisphere-cosine", [])]
+USES_LIGHTS = {"light-area", "light-solid-angle", "mis"}
+
+
+# ----- EXR input -------------------------------------------------------------------------------
+
+NO_COMPRESSION, ZIPS_COMPRESSION, ZIP_COMPRESSION = 0, 2, 3
+FLOAT_PIXELS = 2
+
+
+def read_exr(path):
+    """Channels of a single-part scanline EXR of FLOAT channels, uncompressed or ZIP(S), as a
+    dict name → (height, width) float32 array (OpenEXR "File Layout" and ImfZip.cpp)."""
+    data = Path(path).read_bytes()
+    if data[:4] != b"\x76\x2f\x31\x01":
+        raise ValueError("%s: not an OpenEXR file" % path)
+    if data[5] & 0x1e:  # version flags: tiled, long names, deep, multipart
+        raise ValueError("%s: only single-part scanline EXRs are supported" % path)
+    pos, attributes = 8, {}
+    while data[pos] != 0:
+        end = data.index(b"\0", pos)
+        name = data[pos:end].decode()
+        end2 = data.index(b"\0", end + 1)
+        size, = struct.unpack_from("<i", data, end2 + 1)
+        attributes[name] = data[end2 + 5:end2 + 5 + size]
+        pos = end2 + 5 + size
+    pos += 1
+    channels, raw, p = [], attributes["channels"], 0
+    while raw[p] != 0:
+        end = raw.index(b"\0", p)
+        name = raw[p:end].decode()
+        pixel_type, = struct.unpack_from("<i", raw, end + 1)
+        if pixel_type != FLOAT_PIXELS:
+            raise ValueError("%s: channel %s is not 32-bit float" % (path, name))
+        channels.append(name)  # stored in this (alphabetical) order
+        p = end + 17
+    compression = attributes["compression"][0]
+    lines_per_chunk = {NO_COMPRESSION: 1, ZIPS_COMPRESSION: 1, ZIP_COMPRESSION: 16}.get(compression)
+    if lines_per_chunk is None:
+        raise ValueError("%s: compression %d is not supported" % (path, compression))
+    xmin, ymin, xmax, ymax = struct.unpack("<4i", attributes["dataWindow"])
+    width, height = xmax - xmin + 1, ymax - ymin + 1
+    chunks = (height + lines_per_chunk - 1) // lines_per_chunk
+    offsets = struct.unpack_from("<%dQ" % chunks, data, pos)
+    image = np.zeros((height, len(channels), width), np.float32)
+    for offset in offsets:
+        y, size = struct.unpack_from("<ii", data, offset)
+        block = data[offset + 8:offset + 8 + size]
+        lines = min(lines_per_chunk, ymax - y + 1)
+        raw_size = lines * len(channels) * width * 4
+        if size < raw_size:
+            # ZIP: zlib, then undo the predictor (running sum of byte deltas − 128) and the
+            # split of even and odd bytes into two halves.
+            t = np.frombuffer(zlib.decompress(block), np.uint8)
+            t = (np.cumsum(t.astype(np.int64) - 128) + 128).astype(np.uint8)
+            half = (len(t) + 1) // 2
+            block = np.empty_like(t)
+            block[0::2], block[1::2] = t[:half], t[half:]
+            block = block.tobytes()
+        values = np.frombuffer(block, "<f4").reshape(lines, len(channels), width)
+        image[y - ymin:y - ymin + lines] = values
+    return {name: image[:, i, :] for i, name in enumerate(channels)}
+
+
+# ----- measurements ----------------------------------------------------------------------------
+
+def render(mcrt, scene, estimator, extra, select, seed, args, scratch):
+    stem = scratch / ("%s-%s%s-%s-%d" % (scene, estimator, "".join(extra[1:]), select, seed))
+    command = [str(mcrt), "render", str(ROOT / "scenes" / "stress" / (scene + ".gltf")),
+               "--out", str(stem) + ".exr", "--stats", str(stem) + ".json",
+               "--width", str(args.size), "--height", str(args.size), "--spp", str(args.spp),
+               "--estimator", estimator, "--light-select", select, "--seed", str(seed),
+               "--quiet", *extra]
+    done = subprocess.run(command, capture_output=True, text=True)
+    if done.returncode != 0:
+        sys.exit("%s\nexit %d: %s" % (" ".join(command), done.returncode, done.stderr.strip()))
+    stats = json.loads(Path(str(stem) + ".json").read_text())
+    exr = read_exr(str(stem) + ".exr")
+    rgb = np.stack([exr[c] for c in "RGB"]).astype(np.float64)
+    variance = np.stack([exr["variance." + c] for c in "RGB"]).astype(np.float64)
+    return rgb, variance, stats
+
+
+def measure(mcrt, scene, estimator, extra, select, args, scratch):
+    means, seconds, nan, pixel_mean, pixel_var = [], [], 0, 0.0, 0.0
+    for k in range(args.seeds):
+        rgb, variance, stats = render(mcrt, scene, estimator, extra, select, 1 + k, args, scratch)
+        means.append(rgb.mean())
+        seconds.append(stats["seconds_render"])
+        nan += stats["nan_samples"]
+        pixel_mean += rgb.mean() / args.seeds
+        pixel_var += variance.mean() / args.seeds
+    mean = statistics.fmean(means)
+    rse = statistics.stdev(means) / mean if mean > 0 else math.inf
+    px_rse = math.sqrt(pixel_var) / pixel_mean if pixel_mean > 0 else math.inf
+    return {"mean": mean, "rse": rse, "px_rse": px_rse, "seconds": min(seconds),
+            "nan": nan}
+
+
+def percent(x):
+    if math.isinf(x):
+        return "∞"
+    return "%.3g%%" % (100 * x)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--mcrt", default=str(ROOT / "build" / "mcrt"), help="mcrt executable")
+    parser.add_argument("--seeds", type=int, default=8, help="independent renders K")
+    parser.add_argument("--spp", type=int, default=64, help="samples per pixel")
+    parser.add_argument("--size", type=int, default=128, help="image width and height")
+    parser.add_argument("--scenes", nargs="+", default=SCENES, choices=SCENES)
+    parser.add_argument("--keep", help="keep the EXRs and JSONs in this directory")
+    args = parser.parse_args()
+
+    with tempfile.TemporaryDirectory(prefix="mcrt-stress-") as temporary:
+        scratch = Path(args.keep) if args.keep else Path(temporary)
+        scratch.mkdir(parents=True, exist_ok=True)
+        rows = []  # (scene, label, select, measurement)
+        for scene in args.scenes:
+            scene_rows = []
+            for label, estimator, extra in ESTIMATORS:
+                selects = ["power"]
+                if scene in SELECTION_SCENES and estimator in USES_LIGHTS:
+                    selects = ["uniform", "power", "alias"]
+                for select in selects:
+                    m = measure(args.mcrt, scene, estimator, extra, select, args, scratch)
+                    scene_rows.append((scene, label, select, m))
+                    print("%s / %s / %s: RSE %s, %.3f s" % (scene, label, select,
+                                                            percent(m["rse"]), m["seconds"]),
+                          file=sys.stderr)
+            t_ref = statistics.median(m["seconds"] for *_, m in scene_rows)
+            for *_, m in scene_rows:
+                m["rse_t"] = m["rse"] * math.sqrt(m["seconds"] / t_ref)
+            rows += scene_rows
+
+    print("%d×%d pixels, %d spp, K = %d seeds; cell: RSE at equal spp · RSE at equal time\n"
+          % (args.size, args.size, args.spp, args.seeds))
+    keys = []
+    for _, label, select, _ in rows:
+        if (label, select) not in keys:
+            keys.append((label, select))
+    keys.sort(key=lambda k: ([e[0] for e in ESTIMATORS].index(k[0]),
+                             ["power", "uniform", "alias"].index(k[1])))
+    cells = {(s, l, sel): m for s, l, sel, m in rows}
+    print("| estimator | " + " | ".join(args.scenes) + " |")
+    print("|---|" + "---|" * len(args.scenes))
+    for label, select in keys:
+        name = label if select == "power" else "%s, %s" % (label, select)
+        line = []
+        for scene in args.scenes:
+            m = cells.get((scene, label, select))
+            if m is None:
+                line.append("")
+            else:
+                nan = " (NaN: %d)" % m["nan"] if m["nan"] else ""
+                line.append("%s · %s%s" % (percent(m["rse"]), percent(m["rse_t"]), nan))
+        print("| %s | %s |" % (name, " | ".join(line)))
+
+    print("\n| scene | estimator | selection | image mean | RSE | RSE_t | px RSE | s/render | NaN |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for scene, label, select, m in rows:
+        print("| %s | %s | %s | %.5g | %s | %s | %s | %.3f | %d |" % (
+            scene, label, select, m["mean"], percent(m["rse"]), percent(m["rse_t"]),
+            percent(m["px_rse"]), m["seconds"], m["nan"]))
+    if any(m["nan"] for *_, m in rows):
+        sys.exit("non-finite samples: see the NaN column")
+
+
+if __name__ == "__main__":
+    main()
