@@ -11,26 +11,41 @@
 
 namespace mcrt::test {
 
-// The mean over each pixel's jittered footprint (box filter) of value(p), p where the pixel's
-// ray meets the plane y = 0: an 8×8 midpoint rule over the jitter square, 3 doubles per pixel.
+// The mean over each pixel's jittered footprint (box filter) of value(eye, d) for the rays
+// eye + t·d through the pixel: a q×q midpoint rule over the jitter square, 3 doubles per pixel.
 template <typename F>
-std::vector<double> exact_plane_image(const Camera& camera, int w, int h, F value) {
+std::vector<double> exact_pixel_image(const Camera& camera, int w, int h, int q, F value) {
     gpu::CameraGpu cam = make_gpu_camera(camera, w, h);
     glm::dvec3 eye(cam.eye.x, cam.eye.y, cam.eye.z), fwd(cam.forward.x, cam.forward.y, cam.forward.z),
         right(cam.right.x, cam.right.y, cam.right.z), up(cam.up.x, cam.up.y, cam.up.z);
     std::vector<double> img(3 * size_t(w) * h);
-    const int q = 8;
     for (int j = 0; j < h; ++j)
         for (int i = 0; i < w; ++i)
             for (int b = 0; b < q; ++b)
                 for (int a = 0; a < q; ++a) {
                     double x = 2.0 * (i + (a + 0.5) / q) / w - 1.0;
                     double y = 1.0 - 2.0 * (j + (b + 0.5) / q) / h;
-                    glm::dvec3 d = fwd + x * right + y * up;
-                    glm::dvec3 v = value(eye + (-eye.y / d.y) * d);
+                    glm::dvec3 v = value(eye, fwd + x * right + y * up);
                     for (int c = 0; c < 3; ++c) img[3 * (size_t(j) * w + i) + c] += v[c] / (q * q);
                 }
     return img;
+}
+
+// As exact_pixel_image with q = 8, for value(p) at the point p where the ray meets y = 0.
+template <typename F>
+std::vector<double> exact_plane_image(const Camera& camera, int w, int h, F value) {
+    return exact_pixel_image(camera, w, h, 8, [&](glm::dvec3 eye, glm::dvec3 d) {
+        return value(eye + (-eye.y / d.y) * d);
+    });
+}
+
+// The mean of an image of 3 doubles per pixel.
+inline glm::dvec3 image_mean(const std::vector<double>& img) {
+    glm::dvec3 m(0.0);
+    size_t n = img.size() / 3;
+    for (size_t p = 0; p < n; ++p)
+        for (int c = 0; c < 3; ++c) m[c] += img[3 * p + c] / double(n);
+    return m;
 }
 
 // Camera at `eye` looking straight down −Y, image up = −Z.

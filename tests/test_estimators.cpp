@@ -60,14 +60,6 @@ Renders independent_renders(const DeviceContext& device, const GpuSceneData& dat
     return r;
 }
 
-glm::dvec3 image_mean(const std::vector<double>& img) {
-    glm::dvec3 m(0.0);
-    size_t n = img.size() / 3;
-    for (size_t p = 0; p < n; ++p)
-        for (int c = 0; c < 3; ++c) m[c] += img[3 * p + c] / double(n);
-    return m;
-}
-
 // |mean − exact| within 4.5 standard errors in every channel. With 10 renders the standard
 // error is itself uncertain (χ² with 9 degrees of freedom); 4.5 leaves room for that.
 void check_unbiased(const Renders& r, glm::dvec3 exact, const std::string& what) {

@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "analytic_scenes.h"
 #include "bvh/bvh.h"
 #include "device_support.h"
 #include "image/image.h"
@@ -132,45 +133,23 @@ double intersect(const ExactTriangle& t, glm::dvec3 o, glm::dvec3 d) {
 // Le seen + reflected direct light, box filter as a midpoint rule over each pixel.
 std::vector<double> exact_image(const Scene& scene, const Camera& camera, int w, int h) {
     std::vector<ExactTriangle> tris = exact_triangles(scene);
-    gpu::CameraGpu cam = make_gpu_camera(camera, w, h);
-    glm::dvec3 eye(cam.eye.x, cam.eye.y, cam.eye.z),
-        fwd(cam.forward.x, cam.forward.y, cam.forward.z),
-        right(cam.right.x, cam.right.y, cam.right.z), up(cam.up.x, cam.up.y, cam.up.z);
-    std::vector<double> img(3 * size_t(w) * h);
     // 32×32 points per pixel: the edges of the floor and the wall against the black background
     // cross pixels, and 8×8 leaves a quadrature error of about one standard error there.
-    const int q = 32;
-    for (int j = 0; j < h; ++j)
-        for (int i = 0; i < w; ++i)
-            for (int b = 0; b < q; ++b)
-                for (int a = 0; a < q; ++a) {
-                    double x = 2.0 * (i + (a + 0.5) / q) / w - 1.0;
-                    double y = 1.0 - 2.0 * (j + (b + 0.5) / q) / h;
-                    glm::dvec3 d = fwd + x * right + y * up;
-                    const ExactTriangle* hit = nullptr;
-                    double t_hit = std::numeric_limits<double>::infinity();
-                    for (const ExactTriangle& t : tris) {
-                        double s = intersect(t, eye, d);
-                        if (s > 0 && s < t_hit) t_hit = s, hit = &t;
-                    }
-                    if (!hit) continue;
-                    glm::dvec3 p = eye + t_hit * d;
-                    bool front = glm::dot(hit->n, d) < 0;
-                    glm::dvec3 n = front ? hit->n : -hit->n;
-                    glm::dvec3 v = reflected(tris, *hit, p, n);
-                    if (front || hit->material->double_sided)
-                        v += glm::dvec3(hit->material->emission);
-                    for (int c = 0; c < 3; ++c) img[3 * (size_t(j) * w + i) + c] += v[c] / (q * q);
-                }
-    return img;
-}
-
-glm::dvec3 image_mean(const std::vector<double>& img) {
-    glm::dvec3 m(0.0);
-    size_t n = img.size() / 3;
-    for (size_t p = 0; p < n; ++p)
-        for (int c = 0; c < 3; ++c) m[c] += img[3 * p + c] / double(n);
-    return m;
+    return exact_pixel_image(camera, w, h, 32, [&](glm::dvec3 eye, glm::dvec3 d) {
+        const ExactTriangle* hit = nullptr;
+        double t_hit = std::numeric_limits<double>::infinity();
+        for (const ExactTriangle& t : tris) {
+            double s = intersect(t, eye, d);
+            if (s > 0 && s < t_hit) t_hit = s, hit = &t;
+        }
+        if (!hit) return glm::dvec3(0.0);
+        glm::dvec3 p = eye + t_hit * d;
+        bool front = glm::dot(hit->n, d) < 0;
+        glm::dvec3 n = front ? hit->n : -hit->n;
+        glm::dvec3 v = reflected(tris, *hit, p, n);
+        if (front || hit->material->double_sided) v += glm::dvec3(hit->material->emission);
+        return v;
+    });
 }
 
 // ---- Renders -----------------------------------------------------------------------------------

@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "bench/bench.h"
 #include "bvh/bvh.h"
 #include "cl/cl_error.h"
 #include "cl/device.h"
@@ -323,8 +324,17 @@ int run_cli(int argc, char** argv) {
     render_cmd->add_flag("--quiet", o.quiet, "no progress output");
 
     CLI::App* bench_cmd = app.add_subcommand("bench", "time ray queries on a scene");
-    std::string bench_scene;
-    bench_cmd->add_option("scene", bench_scene, "glTF scene")->required();
+    BenchOptions bench_options;
+    bench_cmd->add_option("scene", bench_options.scene, "glTF scene (.gltf or .glb)")->required();
+    bench_cmd->add_option("--rays", bench_options.rays, "ray kind (default: all three)")
+        ->check(CLI::IsMember({"primary", "shadow", "ambient"}));
+    bench_cmd->add_option("--width", bench_options.width, "image width")->capture_default_str()->check(CLI::Range(1, 16384));
+    bench_cmd->add_option("--height", bench_options.height, "image height")->capture_default_str()->check(CLI::Range(1, 16384));
+    bench_cmd->add_option("--repeats", bench_options.repeats, "timed runs after a warm-up (median)")
+        ->capture_default_str()->check(CLI::Range(1, 1000));
+    bench_cmd->add_option("--device", bench_options.device, "device index from `mcrt devices`")
+        ->capture_default_str()->check(CLI::Range(0, 1 << 30));
+    bench_cmd->add_flag("--json", bench_options.json, "one JSON object per ray kind and line");
     IntegrateOptions integrate_options;
     add_integrate_command(app, integrate_options);
 
@@ -347,7 +357,7 @@ int run_cli(int argc, char** argv) {
             return run_render(o);
         }
         if (app.got_subcommand("integrate")) return run_integrate(integrate_options);
-        if (app.got_subcommand("bench")) throw InputError("bench: not yet supported");
+        if (app.got_subcommand("bench")) return run_bench(bench_options, print_warning);
     } catch (const InputError& e) {
         std::cerr << "mcrt: error: " << e.what() << std::endl;
         return 2;
