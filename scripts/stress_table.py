@@ -19,8 +19,8 @@ and measures, from the K EXRs and stats JSONs:
 An RSE of "∞" means every render's image mean was 0 (no sample found light). Prints Markdown
 tables: RSE and RSE_t as an estimator × scene matrix, then every measurement.
 
-The EXRs are read here (ZIP or uncompressed scanline float EXR, as mcrt writes them) with zlib
-and numpy: Debian 12 has no Python OpenEXR binding.
+The EXRs are read with scripts/mcrt_exr.py (zlib and numpy: Debian 12 has no Python OpenEXR
+binding).
 
 Usage: scripts/stress_table.py [--mcrt build/mcrt] [--seeds 8] [--spp 64] [--size 128]
                                [--scenes NAME ...] [--keep DIR]
@@ -30,14 +30,14 @@ import argparse
 import json
 import math
 import statistics
-import struct
 import subprocess
 import sys
 import tempfile
-import zlib
 from pathlib import Path
 
 import numpy as np
+
+from mcrt_exr import read_exr
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ["tiny-bright-light", "near-light", "grazing-light", "light-facing-away", "many-lights",
@@ -52,66 +52,6 @@ ESTIMATORS = [("light-area", "light-area", []),
               ("hemisphere-uniform", "hemisphere-uniform", []),
               ("hemisphere-cosine", "hemisphere-cosine", [])]
 USES_LIGHTS = {"light-area", "light-solid-angle", "mis"}
-
-
-# ----- EXR input -------------------------------------------------------------------------------
-
-NO_COMPRESSION, ZIPS_COMPRESSION, ZIP_COMPRESSION = 0, 2, 3
-FLOAT_PIXELS = 2
-
-
-def read_exr(path):
-    """Channels of a single-part scanline EXR of FLOAT channels, uncompressed or ZIP(S), as a
-    dict name → (height, width) float32 array (OpenEXR "File Layout" and ImfZip.cpp)."""
-    data = Path(path).read_bytes()
-    if data[:4] != b"\x76\x2f\x31\x01":
-        raise ValueError("%s: not an OpenEXR file" % path)
-    if data[5] & 0x1e:  # version flags: tiled, long names, deep, multipart
-        raise ValueError("%s: only single-part scanline EXRs are supported" % path)
-    pos, attributes = 8, {}
-    while data[pos] != 0:
-        end = data.index(b"\0", pos)
-        name = data[pos:end].decode()
-        end2 = data.index(b"\0", end + 1)
-        size, = struct.unpack_from("<i", data, end2 + 1)
-        attributes[name] = data[end2 + 5:end2 + 5 + size]
-        pos = end2 + 5 + size
-    pos += 1
-    channels, raw, p = [], attributes["channels"], 0
-    while raw[p] != 0:
-        end = raw.index(b"\0", p)
-        name = raw[p:end].decode()
-        pixel_type, = struct.unpack_from("<i", raw, end + 1)
-        if pixel_type != FLOAT_PIXELS:
-            raise ValueError("%s: channel %s is not 32-bit float" % (path, name))
-        channels.append(name)  # stored in this (alphabetical) order
-        p = end + 17
-    compression = attributes["compression"][0]
-    lines_per_chunk = {NO_COMPRESSION: 1, ZIPS_COMPRESSION: 1, ZIP_COMPRESSION: 16}.get(compression)
-    if lines_per_chunk is None:
-        raise ValueError("%s: compression %d is not supported" % (path, compression))
-    xmin, ymin, xmax, ymax = struct.unpack("<4i", attributes["dataWindow"])
-    width, height = xmax - xmin + 1, ymax - ymin + 1
-    chunks = (height + lines_per_chunk - 1) // lines_per_chunk
-    offsets = struct.unpack_from("<%dQ" % chunks, data, pos)
-    image = np.zeros((height, len(channels), width), np.float32)
-    for offset in offsets:
-        y, size = struct.unpack_from("<ii", data, offset)
-        block = data[offset + 8:offset + 8 + size]
-        lines = min(lines_per_chunk, ymax - y + 1)
-        raw_size = lines * len(channels) * width * 4
-        if size < raw_size:
-            # ZIP: zlib, then undo the predictor (running sum of byte deltas − 128) and the
-            # split of even and odd bytes into two halves.
-            t = np.frombuffer(zlib.decompress(block), np.uint8)
-            t = (np.cumsum(t.astype(np.int64) - 128) + 128).astype(np.uint8)
-            half = (len(t) + 1) // 2
-            block = np.empty_like(t)
-            block[0::2], block[1::2] = t[:half], t[half:]
-            block = block.tobytes()
-        values = np.frombuffer(block, "<f4").reshape(lines, len(channels), width)
-        image[y - ymin:y - ymin + lines] = values
-    return {name: image[:, i, :] for i, name in enumerate(channels)}
 
 
 # ----- measurements ----------------------------------------------------------------------------

@@ -296,6 +296,8 @@ TEST_CASE("Broken files throw InputError naming the file and the element", "[glt
         {"material_out_of_range.gltf", "material 2 out of range"},
         {"scene_out_of_range.gltf", "scene 4 out of range"},
         {"rootless_cycle.gltf", "node cycle"},
+        // Found by fuzzing: Le × area overflowed the float power of light selection.
+        {"emitter_power_overflow.gltf", "mesh 0 primitive 0: triangle 0: emitted power"},
     };
     for (const Broken& b : broken) {
         INFO(b.file);
@@ -330,6 +332,69 @@ TEST_CASE("Missing and garbage files throw InputError naming the file", "[gltf][
         CHECK(load_error(path).find(name) != std::string::npos);
     }
     std::filesystem::remove_all(dir);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Loading from memory (the fuzz target's entry point, tests/fuzz) and the fuzz corpus
+// ---------------------------------------------------------------------------------------------
+
+std::vector<unsigned char> file_bytes(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::vector<unsigned char>((std::istreambuf_iterator<char>(in)),
+                                      std::istreambuf_iterator<char>());
+}
+
+TEST_CASE("load_gltf_from_memory imports what load_gltf imports", "[gltf][memory]") {
+    for (const std::string& name : {"trs_transform.gltf", "shared_subtree.gltf"}) {
+        INFO(name);
+        const mcrt::Scene from_file = mcrt::load_gltf(test_data(name), nullptr);
+        const mcrt::Scene from_memory =
+            mcrt::load_gltf_from_memory(name, file_bytes(test_data(name)), nullptr);
+        CHECK(from_memory.path == name);
+        CHECK(from_memory.positions == from_file.positions);
+        CHECK(from_memory.triangle_material == from_file.triangle_material);
+        CHECK(from_memory.materials.size() == from_file.materials.size());
+    }
+    const std::string glb = shared_scene("robustness/tinygltf/box01.glb");
+    CHECK(mcrt::load_gltf_from_memory("box01.glb", file_bytes(glb), nullptr).triangle_count() ==
+          12);
+    // Broken files fail the same way, named by the name given.
+    try {
+        mcrt::load_gltf_from_memory("cycle", file_bytes(test_data("node_cycle.gltf")), nullptr);
+        FAIL("node_cycle.gltf loaded from memory");
+    } catch (const mcrt::InputError& e) {
+        CHECK(std::string(e.what()).find("cycle: node cycle through node 0") == 0);
+    }
+}
+
+TEST_CASE("load_gltf_from_memory reads nothing from disk", "[gltf][memory]") {
+    // A buffer naming a file that exists next to the working directory is still refused.
+    const std::string text = R"({"asset": {"version": "2.0"}, "buffers": [{"uri": ")" +
+                             test_data("trs_transform.gltf") + R"(", "byteLength": 4}]})";
+    const std::vector<unsigned char> bytes(text.begin(), text.end());
+    REQUIRE_THROWS_AS(mcrt::load_gltf_from_memory("external.gltf", bytes, nullptr),
+                      mcrt::InputError);
+    REQUIRE_THROWS_AS(mcrt::load_gltf_from_memory("empty.gltf", {}, nullptr), mcrt::InputError);
+    const std::vector<unsigned char> truncated_glb = {'g', 'l', 'T', 'F', 2, 0, 0, 0, 64, 0};
+    REQUIRE_THROWS_AS(mcrt::load_gltf_from_memory("truncated.glb", truncated_glb, nullptr),
+                      mcrt::InputError);
+}
+
+// The fuzzer's seed corpus, with every input that ever crashed it: each loads or is refused.
+TEST_CASE("Every file of the fuzz corpus loads or throws InputError", "[gltf][robustness][fuzz]") {
+    const std::filesystem::path corpus = std::filesystem::path(MCRT_TEST_DATA) / "../fuzz/corpus";
+    REQUIRE(std::filesystem::is_directory(corpus));
+    size_t files = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(corpus)) {
+        INFO(entry.path().filename().string());
+        ++files;
+        try {
+            mcrt::load_gltf_from_memory(entry.path().filename().string(),
+                                        file_bytes(entry.path().string()), nullptr);
+        } catch (const mcrt::InputError&) {
+        }
+    }
+    CHECK(files >= 30);
 }
 
 // Every integer of Box.gltf's JSON replaced, one at a time, by out-of-range or negative values:

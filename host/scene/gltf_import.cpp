@@ -121,25 +121,73 @@ std::string one_line(const std::string& text) {
     return joined.empty() ? "invalid glTF file" : joined;
 }
 
+// A loader that keeps image bytes undecoded.
+tinygltf::TinyGLTF make_loader() {
+    tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(skip_image_decoding, nullptr);
+    return loader;
+}
+
+// Runs one tinygltf load call; a false return or an exception becomes InputError naming `name`.
+template <typename LoadCall>
+tinygltf::Model parse_model(const std::string& name, LoadCall load) {
+    tinygltf::Model model;
+    std::string error, warning;  // tinygltf's warnings concern images and unknown data: dropped
+    bool ok = false;
+    try {
+        ok = load(&model, &error, &warning);
+    } catch (const std::exception& e) {
+        throw InputError(name + ": " + e.what());
+    }
+    if (!ok) throw InputError(name + ": " + one_line(error));
+    return model;
+}
+
 tinygltf::Model read_model(const std::string& path) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) {
         throw InputError(path + ": cannot open: no such file");
     }
-    tinygltf::TinyGLTF loader;
-    loader.SetImageLoader(skip_image_decoding, nullptr);
-    tinygltf::Model model;
-    std::string error, warning;  // tinygltf's warnings concern images and unknown data: dropped
-    bool ok = false;
-    try {
-        ok = has_glb_magic(path) || has_glb_extension(path)
-                 ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
-                 : loader.LoadASCIIFromFile(&model, &error, &warning, path);
-    } catch (const std::exception& e) {
-        throw InputError(path + ": " + e.what());
+    tinygltf::TinyGLTF loader = make_loader();
+    const bool binary = has_glb_magic(path) || has_glb_extension(path);
+    return parse_model(path, [&](tinygltf::Model* model, std::string* error, std::string* warning) {
+        return binary ? loader.LoadBinaryFromFile(model, error, warning, path)
+                      : loader.LoadASCIIFromFile(model, error, warning, path);
+    });
+}
+
+// File-system callbacks for loading from memory: no file exists, so a uri naming a file fails
+// with tinygltf's "File not found" and nothing is read from disk.
+bool no_file_exists(const std::string&, void*) { return false; }
+std::string path_unchanged(const std::string& path, void*) { return path; }
+bool no_file_read(std::vector<unsigned char>*, std::string* error, const std::string& path, void*) {
+    if (error) *error = path + ": external files are not read when loading from memory";
+    return false;
+}
+bool no_file_write(std::string* error, const std::string&, const std::vector<unsigned char>&,
+                   void*) {
+    if (error) *error = "not writable";
+    return false;
+}
+
+tinygltf::Model read_model_from_memory(const std::string& name,
+                                       const std::vector<unsigned char>& bytes) {
+    if (bytes.empty()) throw InputError(name + ": the file is empty");
+    if (bytes.size() > std::numeric_limits<unsigned int>::max()) {
+        throw InputError(name + ": larger than 4 GiB");  // tinygltf takes an unsigned length
     }
-    if (!ok) throw InputError(path + ": " + one_line(error));
-    return model;
+    tinygltf::TinyGLTF loader = make_loader();
+    loader.SetFsCallbacks(tinygltf::FsCallbacks{no_file_exists, path_unchanged, no_file_read,
+                                                no_file_write, nullptr});
+    const auto length = static_cast<unsigned int>(bytes.size());
+    const bool binary =
+        (bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0) || has_glb_extension(name);
+    return parse_model(name, [&](tinygltf::Model* model, std::string* error, std::string* warning) {
+        return binary ? loader.LoadBinaryFromMemory(model, error, warning, bytes.data(), length, "")
+                      : loader.LoadASCIIFromString(model, error, warning,
+                                                   reinterpret_cast<const char*>(bytes.data()),
+                                                   length, "");
+    });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -655,8 +703,23 @@ void Importer::import_primitive(const tinygltf::Primitive& primitive, const std:
     // front face stays the one the file means.
     const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
     const uint32_t material = material_slot(primitive.material, element);
+    const Material& surface = scene_.materials[material];
+    const double Le_luminance = luminance(surface.emission);
     for (size_t t = 0; t < triangles; ++t) {
         const uint32_t a = corners[3 * t], b = corners[3 * t + 1], c = corners[3 * t + 2];
+        // An emitter's power, luminance(Le) × area × π (×2 double-sided), is a float in light
+        // selection (scene.h EmissiveTriangle): it must not overflow (found by fuzzing).
+        if (Le_luminance > 0.0) {
+            const double area = 0.5 * glm::length(glm::cross(positions[b] - positions[a],
+                                                             positions[c] - positions[a]));
+            const double power =
+                Le_luminance * area * glm::pi<double>() * (surface.double_sided ? 2.0 : 1.0);
+            if (!(power <= 0.5 * std::numeric_limits<float>::max())) {
+                diag_.fail(element, "triangle " + std::to_string(t) + ": emitted power " +
+                                        format_number(power) +
+                                        " overflows single precision (emission × area too large)");
+            }
+        }
         scene_.positions.push_back(glm::vec3(positions[a]));
         scene_.positions.push_back(glm::vec3(positions[mirrored ? c : b]));
         scene_.positions.push_back(glm::vec3(positions[mirrored ? b : c]));
@@ -794,6 +857,13 @@ Scene load_gltf(const std::string& path, const WarningSink& warn) {
     const tinygltf::Model model = read_model(path);
     Diagnostics diag(path, warn);
     return Importer(model, diag).import_default_scene(path);
+}
+
+Scene load_gltf_from_memory(const std::string& name, const std::vector<unsigned char>& bytes,
+                            const WarningSink& warn) {
+    const tinygltf::Model model = read_model_from_memory(name, bytes);
+    Diagnostics diag(name, warn);
+    return Importer(model, diag).import_default_scene(name);
 }
 
 }  // namespace mcrt

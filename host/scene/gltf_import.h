@@ -3,6 +3,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "scene/scene.h"
 
@@ -15,5 +16,11 @@ using WarningSink = std::function<void(const std::string&)>;
 // element) for unreadable or invalid files: out-of-range indices, node cycles, accessors that
 // overrun their buffer views, non-finite positions, ...
 Scene load_gltf(const std::string& path, const WarningSink& warn);
+
+// The same from the bytes of a .gltf or .glb file (GLB when they start with "glTF" or `name`
+// ends in .glb); `name` stands for the file in messages. Nothing is read from disk: buffers and
+// images must be embedded (data: URIs or the GLB binary chunk), a file name in a uri is refused.
+Scene load_gltf_from_memory(const std::string& name, const std::vector<unsigned char>& bytes,
+                            const WarningSink& warn);
 
 }  // namespace mcrt

@@ -1,0 +1,69 @@
+// libFuzzer target: the bytes of a .gltf or .glb file through mcrt's glTF import, as
+// `mcrt render` loads a scene. Refusing a file (InputError) is the expected outcome for most
+// inputs; anything else escaping is a crash, and so is an imported scene that breaks the
+// contract the renderer relies on (finite positions, in-range materials, finite emission,
+// rigid cameras with yfov in (0, pi)), which the checks below turn into an abort.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "common/error.h"
+#include "scene/gltf_import.h"
+#include "scene/scene.h"
+
+namespace {
+
+bool finite(const glm::vec3& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+void require(bool condition, const char* what) {
+    if (condition) return;
+    std::fprintf(stderr, "fuzz_gltf_import: imported scene breaks the contract: %s\n", what);
+    std::abort();
+}
+
+// What the renderer assumes of every scene load_gltf returns.
+void check_scene(const mcrt::Scene& scene) {
+    require(scene.positions.size() == 3 * scene.triangle_count(), "three corners per triangle");
+    for (const glm::vec3& p : scene.positions) require(finite(p), "finite positions");
+    for (uint32_t m : scene.triangle_material)
+        require(m < scene.materials.size(), "material in range");
+    for (const mcrt::Material& m : scene.materials) {
+        require(finite(m.albedo) && glm::all(glm::greaterThanEqual(m.albedo, glm::vec3(0.0f))),
+                "finite non-negative albedo");
+        require(finite(m.emission) && glm::all(glm::greaterThanEqual(m.emission, glm::vec3(0.0f))),
+                "finite non-negative emission");
+    }
+    for (const mcrt::Camera& c : scene.cameras) {
+        require(c.yfov > 0.0f && c.yfov < 3.14159275f, "yfov in (0, pi)");
+        for (int i = 0; i < 4; ++i)
+            require(finite(glm::vec3(c.camera_to_world[i])), "finite camera");
+    }
+    require(finite(scene.bounds_min()) && finite(scene.bounds_max()), "finite bounds");
+    for (const mcrt::EmissiveTriangle& e : mcrt::collect_emitters(scene)) {
+        require(e.triangle < scene.triangle_count(), "emitter in range");
+        require(std::isfinite(e.area) && e.area > 0.0f, "finite positive emitter area");
+        require(std::isfinite(e.power) && e.power >= 0.0f, "finite emitter power");
+    }
+    const mcrt::Camera bench = mcrt::bench_camera(scene);
+    for (int i = 0; i < 4; ++i)
+        require(finite(glm::vec3(bench.camera_to_world[i])), "finite bench camera");
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    // A copy of exactly `size` bytes, so that ASan sees any read past the end.
+    const std::vector<unsigned char> bytes(data, data + size);
+    try {
+        const mcrt::Scene scene =
+            mcrt::load_gltf_from_memory("fuzz-input", bytes, [](const std::string&) {});
+        check_scene(scene);
+    } catch (const mcrt::InputError&) {
+        // Refused with a message: what a broken file should get.
+    }
+    return 0;
+}
