@@ -6,7 +6,7 @@
 /* One work-item per pixel sample of a batch. Work-item g renders sample
  * sample_begin + g % batch_samples (of spp in all) of pixel pixel_begin + g / batch_samples
  * < pixel_end (samples of a pixel adjacent) and writes samples[g] = (radiance, rays traced). */
-kernel void render(global const BvhNode* nodes, global const Triangle* triangles,
+kernel void render(global const Bvh4Node* nodes, global const Triangle* triangles,
                    global const Material* materials, global const Light* lights,
                    global const float* light_cdf, global const AliasEntry* light_alias,
                    uint light_count, global const CameraGpu* camera, uint width, uint height,

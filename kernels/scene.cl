@@ -6,7 +6,7 @@
 #include "lights.cl"
 
 typedef struct {
-    global const BvhNode* nodes;
+    global const Bvh4Node* nodes;
     global const Triangle* triangles;
     global const Material* materials;
     LightSet lights;

@@ -18,13 +18,38 @@ using uint = std::uint32_t;
  * image, do not depend on the batch size or the device split. */
 #define MCRT_SAMPLES_PER_CHUNK 16
 
-/* Flat BVH node, 32 bytes. Children of an inner node are adjacent: nodes[first], nodes[first+1].
+/* Longest root-to-leaf path of the binary BVH, in nodes (kMaxBvhDepth on the host): the builder
+ * switches to median splits before a tree could grow deeper. */
+#define MCRT_BVH_MAX_DEPTH 60
+
+/* Binary BVH node of the host's SAH build, 32 bytes (the device traverses Bvh4Node). Children
+ * of an inner node are adjacent: nodes[first], nodes[first+1].
  * lo.xyz / hi.xyz: bounds. lo.w: `first` (child or triangle index, as uint bits).
  * hi.w: triangle count as uint bits; 0 for an inner node. */
 typedef struct {
     float4 lo;
     float4 hi;
 } BvhNode;
+
+/* 4-wide BVH node, 128 bytes: the boxes of its four children in SoA form, so that one slab test
+ * in float4 arithmetic covers all four (Wald, Benthin, Boulos 2008, "Getting rid of packets";
+ * Embree's BVH4). Slot i is
+ *   - an inner child: count[i] == 0, child[i] = index of its Bvh4Node;
+ *   - a leaf: count[i] = number of triangles (> 0), child[i] = first one in leaf order;
+ *   - empty: count[i] == 0, child[i] == 0 and an inverted box (lo = +1e30, hi = -1e30) that the
+ *     traversal's sign-selected slab test always rejects (near plane beyond far plane).
+ * nodes[0] is the root; an empty scene's root has four empty slots. */
+typedef struct {
+    float4 lo_x, hi_x; /* 0, 16: order lo, hi per axis: the slab test picks near/far by index */
+    float4 lo_y, hi_y; /* 32, 48 */
+    float4 lo_z, hi_z; /* 64, 80 */
+    uint child[4];     /* 96 */
+    uint count[4];     /* 112 */
+} Bvh4Node;
+
+/* Longest root-to-leaf path of Bvh4Node (counting inner Bvh4Nodes): every Bvh4Node is an inner
+ * node of the binary tree, so at most MCRT_BVH_MAX_DEPTH - 1 of them lie on a path. */
+#define MCRT_BVH4_MAX_DEPTH (MCRT_BVH_MAX_DEPTH - 1)
 
 /* Triangle in BVH leaf order, 48 bytes: world-space vertices, counter-clockwise seen from the
  * front. p0.w holds the material index as uint bits; p1.w the scene's triangle index; p2.w the
@@ -74,6 +99,7 @@ typedef struct {
 
 #ifndef __OPENCL_VERSION__
 static_assert(sizeof(BvhNode) == 32 && alignof(BvhNode) == 16, "BvhNode layout");
+static_assert(sizeof(Bvh4Node) == 128 && alignof(Bvh4Node) == 16, "Bvh4Node layout");
 static_assert(sizeof(Triangle) == 48 && alignof(Triangle) == 16, "Triangle layout");
 static_assert(sizeof(Material) == 48 && alignof(Material) == 16, "Material layout");
 static_assert(sizeof(Light) == 64 && alignof(Light) == 16, "Light layout");

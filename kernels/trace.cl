@@ -5,7 +5,7 @@
 
 /* Closest hit of ray g: origins[g].xyz, directions[g].xyz, t_max in origins[g].w. Writes
  * hits[g] = (t, b1, b2, leaf-order triangle index as uint bits; NO_HIT on a miss). */
-kernel void trace_closest(global const BvhNode* nodes, global const Triangle* triangles,
+kernel void trace_closest(global const Bvh4Node* nodes, global const Triangle* triangles,
                           global const float4* origins, global const float4* directions,
                           uint ray_count, global float4* hits) {
     size_t g = get_global_id(0);
@@ -16,7 +16,7 @@ kernel void trace_closest(global const BvhNode* nodes, global const Triangle* tr
 }
 
 /* Occlusion of ray g in (0, t_max): occluded[g] = 1 if anything blocks it, else 0. */
-kernel void trace_any(global const BvhNode* nodes, global const Triangle* triangles,
+kernel void trace_any(global const Bvh4Node* nodes, global const Triangle* triangles,
                       global const float4* origins, global const float4* directions,
                       uint ray_count, global uint* occluded) {
     size_t g = get_global_id(0);

@@ -1,5 +1,6 @@
-// Binned SAH BVH build: structure of the flat layout, SAH cost, and closest hits of a reference
-// CPU traversal against brute force (as tinybvh validates each layout against a reference tracer).
+// Binned SAH BVH build and its 4-wide collapse: structure of both flat layouts, SAH costs, and
+// closest hits of reference CPU traversals against brute force (as tinybvh validates each layout
+// against a reference tracer).
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -166,6 +167,110 @@ double sah_cost(const Bvh& bvh, float traversal_cost) {
     return cost;
 }
 
+float lane(const gpu::float4& v, int i) { return i == 0 ? v.x : i == 1 ? v.y : i == 2 ? v.z : v.w; }
+
+// Box of slot s of a 4-wide node.
+Box slot_box(const gpu::Bvh4Node& n, int s) {
+    Box b;
+    b.lo = {lane(n.lo_x, s), lane(n.lo_y, s), lane(n.lo_z, s)};
+    b.hi = {lane(n.hi_x, s), lane(n.hi_y, s), lane(n.hi_z, s)};
+    return b;
+}
+
+bool is_empty_slot(const gpu::Bvh4Node& n, int s) {
+    const Box b = slot_box(n, s);
+    return n.count[s] == 0 && n.child[s] == 0 && b.lo == glm::vec3(1e30f) &&
+           b.hi == glm::vec3(-1e30f);
+}
+
+// Every invariant of the 4-wide tree the kernels traverse: each node reached once from the
+// root, each triangle in exactly one leaf, the leaves those of the binary tree, every slot box
+// tight around its subtree, empty slots inverted, the depth within the traversal stack's bound.
+void validate4(const Bvh& bvh, const BvhBuildOptions& options) {
+    const size_t n = bvh.triangles.size();
+    REQUIRE(!bvh.nodes4.empty());
+    std::vector<int> reached(bvh.nodes4.size(), 0), covered(n, 0);
+    std::vector<std::pair<uint32_t, uint32_t>> leaves4, leaves2;
+    size_t problems = 0, infinite = 0, lonely = 0;
+    int depth = 0;
+    double cost = 0.0, root_area = 0.0;
+    // (node, level), with the box its parent's slot gives it (the root: the union of its slots).
+    struct Item {
+        uint32_t node;
+        int level;
+        Box box;
+        bool from_parent;
+    };
+    std::vector<Item> stack{{0u, 1, Box{}, false}};
+    while (!stack.empty()) {
+        const Item item = stack.back();
+        stack.pop_back();
+        if (++reached[item.node] > 1) continue;
+        depth = std::max(depth, item.level);
+        const gpu::Bvh4Node& node = bvh.nodes4[item.node];
+        Box u;
+        int used = 0;
+        for (int s = 0; s < 4; ++s) {
+            const Box b = slot_box(node, s);
+            for (int k = 0; k < 3; ++k)
+                infinite += !std::isfinite(b.lo[k]) + !std::isfinite(b.hi[k]);
+            if (is_empty_slot(node, s)) continue;
+            ++used;
+            if (!glm::all(glm::lessThanEqual(b.lo, b.hi))) ++problems;
+            u.grow(b.lo), u.grow(b.hi);
+            if (node.count[s] == 0) {
+                if (node.child[s] <= item.node || node.child[s] >= bvh.nodes4.size()) {
+                    ++problems;
+                    continue;
+                }
+                stack.push_back({node.child[s], item.level + 1, b, true});
+                continue;
+            }
+            const uint32_t first = node.child[s], count = node.count[s];
+            if (count > uint32_t(options.max_leaf_size) || size_t(first) + count > n) {
+                ++problems;
+                continue;
+            }
+            leaves4.push_back({first, count});
+            Box tight;
+            for (uint32_t i = first; i < first + count; ++i) {
+                ++covered[i];
+                const gpu::Triangle& t = bvh.triangles[i];
+                for (const gpu::float4& q : {t.p0, t.p1, t.p2}) tight.grow({q.x, q.y, q.z});
+            }
+            if (!same_box(tight, b)) ++problems;
+        }
+        // A child's slot box is exactly the union of its own slots; inner nodes use ≥ 2 slots.
+        if (item.from_parent && (!same_box(u, item.box) || used < 2)) ++problems;
+        if (!item.from_parent) root_area = u.area();  // the root comes first
+        lonely += item.from_parent && used < 2;
+        // SAH cost (PBRT 4.3.2): a node visit costs traversal_cost, a leaf its triangles.
+        auto weight = [&](const Box& b) { return root_area > 0 ? b.area() / root_area : 1.0; };
+        if (used > 0) cost += options.traversal_cost * weight(u);
+        for (int s = 0; s < 4; ++s)
+            if (node.count[s] > 0) cost += node.count[s] * weight(slot_box(node, s));
+    }
+    for (const gpu::BvhNode& node : bvh.nodes)
+        if (node_count(node) > 0) leaves2.push_back({node_first(node), node_count(node)});
+    std::sort(leaves4.begin(), leaves4.end());
+    std::sort(leaves2.begin(), leaves2.end());
+    CHECK(problems == 0);
+    CHECK(lonely == 0);
+    CHECK(infinite == 0);
+    CHECK(leaves4 == leaves2);
+    CHECK(std::count(reached.begin(), reached.end(), 1) == std::ptrdiff_t(bvh.nodes4.size()));
+    CHECK(std::count(covered.begin(), covered.end(), 1) == std::ptrdiff_t(n));
+    CHECK(depth == bvh.stats.depth4);
+    CHECK(depth <= kMaxBvh4Depth);
+    CHECK(depth <= std::max(1, bvh.stats.depth - 1));
+    CHECK(bvh.stats.sah_cost4 == Approx(cost).epsilon(1e-6));
+    CHECK(bvh.stats.bytes == bvh.nodes4.size() * sizeof(gpu::Bvh4Node) + n * sizeof(gpu::Triangle));
+    if (n == 0) {
+        for (int s = 0; s < 4; ++s) CHECK(is_empty_slot(bvh.nodes4[0], s));
+        CHECK(bvh.stats.sah_cost4 == 0.0);
+    }
+}
+
 // Every invariant of the flat layout that the kernels rely on.
 void validate(const Scene& scene, const Bvh& bvh, const BvhBuildOptions& options) {
     const size_t n = scene.triangle_count();
@@ -243,13 +348,13 @@ void validate(const Scene& scene, const Bvh& bvh, const BvhBuildOptions& options
     CHECK(depth == bvh.stats.depth);
     CHECK(bvh.stats.inner_nodes == inner);
     CHECK(bvh.stats.leaves == leaves);
-    CHECK(bvh.stats.bytes == bvh.nodes.size() * sizeof(gpu::BvhNode) + n * sizeof(gpu::Triangle));
     CHECK(bvh.stats.sah_cost == Approx(sah_cost(bvh, options.traversal_cost)).epsilon(1e-6));
     size_t infinite = 0;  // kernels built with -cl-fast-relaxed-math assume no infinities
     for (const gpu::BvhNode& node : bvh.nodes)
         for (float f : {node.lo.x, node.lo.y, node.lo.z, node.hi.x, node.hi.y, node.hi.z})
             infinite += !std::isfinite(f);
     CHECK(infinite == 0);
+    validate4(bvh, options);
 }
 
 struct Ray {
@@ -325,6 +430,47 @@ Hit traverse(const Bvh& bvh, const Ray& ray, bool& overflow) {
     return h;
 }
 
+// Reference traversal of the 4-wide tree as the kernels test it: near and far planes chosen by
+// the ray's signs (so that inverted empty slots are rejected), exit scaled by 1 + 2γ₃.
+Hit traverse4(const Bvh& bvh, const Ray& ray, bool& overflow) {
+    const float gamma3 = 3 * 0x1p-24f / (1 - 3 * 0x1p-24f);
+    const glm::vec3 inv_d = 1.0f / ray.d;
+    Hit h;
+    std::vector<uint32_t> stack{0u};
+    while (!stack.empty()) {
+        const gpu::Bvh4Node& node = bvh.nodes4[stack.back()];
+        stack.pop_back();
+        for (int s = 0; s < 4; ++s) {
+            const Box b = slot_box(node, s);
+            float t_near = 0.0f, t_far = h.t;
+            for (int k = 0; k < 3; ++k) {
+                const float near = inv_d[k] < 0 ? b.hi[k] : b.lo[k];
+                const float far = inv_d[k] < 0 ? b.lo[k] : b.hi[k];
+                t_near = std::max(t_near, (near - ray.o[k]) * inv_d[k]);
+                t_far = std::min(t_far, (far - ray.o[k]) * inv_d[k]);
+            }
+            if (t_near > t_far * (1 + 2 * gamma3)) continue;
+            if (node.count[s] == 0) {
+                stack.push_back(node.child[s]);
+                continue;
+            }
+            for (uint32_t i = node.child[s]; i < node.child[s] + node.count[s]; ++i) {
+                const gpu::Triangle& tri = bvh.triangles[i];
+                float t =
+                    intersect(ray, {tri.p0.x, tri.p0.y, tri.p0.z}, {tri.p1.x, tri.p1.y, tri.p1.z},
+                              {tri.p2.x, tri.p2.y, tri.p2.z}, h.t);
+                if (t > 0.0f) h = {t, int64_t(float_bits(tri.p1.w))};
+            }
+        }
+        // Unordered, so bounded by 4 per level rather than the kernels' 3.
+        if (stack.size() > size_t(4 * kMaxBvh4Depth)) {
+            overflow = true;
+            return h;
+        }
+    }
+    return h;
+}
+
 // Random rays from around the scene, half of them aimed at a point inside its bounds.
 void check_rays(const Scene& scene, const Bvh& bvh, int rays, uint32_t seed) {
     Box b;
@@ -345,7 +491,8 @@ void check_rays(const Scene& scene, const Bvh& bvh, int rays, uint32_t seed) {
         ray.d = target - ray.o;
         if (glm::length(ray.d) == 0.0f) ray.d = glm::vec3(0.3f, 0.5f, 0.8f);
         ray.d = glm::normalize(ray.d);
-        Hit want = brute_force(scene, ray), got = traverse(bvh, ray, overflow);
+        Hit want = brute_force(scene, ray), got = traverse(bvh, ray, overflow),
+            got4 = traverse4(bvh, ray, overflow);
         hits += want.triangle >= 0;
         // Same closest t; a different triangle only when it ties at exactly that t.
         if (want.triangle != got.triangle && want.t != got.t) {
@@ -353,6 +500,12 @@ void check_rays(const Scene& scene, const Bvh& bvh, int rays, uint32_t seed) {
                 UNSCOPED_INFO("ray " << r << ": brute force t " << want.t << " triangle "
                                      << want.triangle << ", BVH t " << got.t << " triangle "
                                      << got.triangle);
+        }
+        if (want.triangle != got4.triangle && want.t != got4.t) {
+            if (mismatches++ == 0)
+                UNSCOPED_INFO("ray " << r << ": brute force t " << want.t << " triangle "
+                                     << want.triangle << ", BVH4 t " << got4.t << " triangle "
+                                     << got4.triangle);
         }
     }
     CHECK(mismatches == 0);
@@ -431,6 +584,12 @@ TEST_CASE("BVH of a single triangle is one leaf", "[bvh]") {
     CHECK(node_count(bvh.nodes[0]) == 1);
     CHECK(bvh.stats.depth == 1);
     CHECK(bvh.stats.sah_cost == Approx(1.0));
+    // The 4-wide root holds the leaf in slot 0 and three empty slots.
+    REQUIRE(bvh.nodes4.size() == 1);
+    CHECK(bvh.nodes4[0].count[0] == 1);
+    CHECK(bvh.nodes4[0].child[0] == 0);
+    for (int s = 1; s < 4; ++s) CHECK(is_empty_slot(bvh.nodes4[0], s));
+    CHECK(bvh.stats.depth4 == 1);
     check_rays(scene, bvh, 10000, 7);
 }
 
@@ -477,8 +636,10 @@ TEST_CASE("BVH depth stays within kMaxBvhDepth on a pathological scene", "[bvh]"
         INFO("max_leaf_size " << max_leaf);
         validate(scene, bvh, options);
         std::cout << "log-uniform scatter, 10000 triangles, max_leaf_size " << max_leaf
-                  << ": depth " << bvh.stats.depth << " (limit " << kMaxBvhDepth << ")\n";
+                  << ": depth " << bvh.stats.depth << " (limit " << kMaxBvhDepth << "), 4-wide "
+                  << bvh.stats.depth4 << " (limit " << kMaxBvh4Depth << ")\n";
         CHECK(bvh.stats.depth <= kMaxBvhDepth);
+        CHECK(bvh.stats.depth4 <= kMaxBvh4Depth);
     }
 }
 
@@ -492,6 +653,9 @@ TEST_CASE("BVH of a scene large enough for a multithreaded build is traced exact
     REQUIRE(again.nodes.size() == bvh.nodes.size());
     CHECK(std::memcmp(again.nodes.data(), bvh.nodes.data(),
                       bvh.nodes.size() * sizeof(gpu::BvhNode)) == 0);
+    REQUIRE(again.nodes4.size() == bvh.nodes4.size());
+    CHECK(std::memcmp(again.nodes4.data(), bvh.nodes4.data(),
+                      bvh.nodes4.size() * sizeof(gpu::Bvh4Node)) == 0);
 }
 
 TEST_CASE("BVH build is deterministic", "[bvh]") {
@@ -525,6 +689,9 @@ TEST_CASE("BVH build of a million triangles completes", "[bvh][large]") {
     std::cout << "1M synthetic triangles (noisy sphere + soup): build " << bvh.stats.build_seconds
               << " s, " << scene.triangle_count() / bvh.stats.build_seconds / 1e6
               << " M triangles/s, SAH cost " << bvh.stats.sah_cost << ", depth " << bvh.stats.depth
-              << ", " << bvh.nodes.size() << " nodes, " << bvh.stats.bytes / 1048576.0 << " MiB\n";
+              << ", " << bvh.nodes.size() << " nodes; 4-wide: collapse "
+              << bvh.stats.collapse_seconds << " s, SAH cost " << bvh.stats.sah_cost4 << ", depth "
+              << bvh.stats.depth4 << ", " << bvh.nodes4.size() << " nodes, "
+              << bvh.stats.bytes / 1048576.0 << " MiB on the device\n";
     validate(scene, bvh, options);
 }

@@ -1,8 +1,10 @@
-// Device BVH traversal (closest hit, any hit) against a brute-force reference in double
-// precision on the same rays, and the watertightness of the ray–triangle test.
+// Device BVH traversal of the 4-wide tree (closest hit, any hit) against a brute-force reference
+// in double precision on the same rays, a deep tree, and the watertightness of the ray–triangle
+// test.
 #include <catch2/catch.hpp>
 
 #include <cfloat>
+#include <cmath>
 #include <cstring>
 #include <random>
 
@@ -39,9 +41,9 @@ struct Tracer {
     std::vector<Out> run(const char* entry, const Bvh& bvh, const RaySet& rays) {
         cl::Kernel k = make_kernel(program, entry);
         std::vector<Out> out(rays.origins.size());
-        cl::Buffer nodes = buffer(bvh.nodes), tris = buffer(bvh.triangles.empty()
-                                                                ? std::vector<gpu::Triangle>(1)
-                                                                : bvh.triangles);
+        cl::Buffer nodes = buffer(bvh.nodes4),
+                   tris = buffer(bvh.triangles.empty() ? std::vector<gpu::Triangle>(1)
+                                                       : bvh.triangles);
         cl::Buffer o = buffer(rays.origins), d = buffer(rays.directions), result = buffer(out);
         CL_CHECK(k.setArg(0, nodes));
         CL_CHECK(k.setArg(1, tris));
@@ -190,6 +192,67 @@ TEST_CASE("no ray escapes a closed mesh through its edges or vertices (watertigh
     for (const gpu::float4& h : hits) misses += bits(h.w) == 0xffffffffu;
     INFO(rays.origins.size() << " rays");
     CHECK(misses == 0);
+}
+
+TEST_CASE("the device sees Bvh4Node with the host's size", "[traversal]") {
+    DeviceContext device = first_device();
+    const std::string source = kernel_source("shared_types.h") +
+                               "kernel void bvh4_node_size(global uint* size) {\n"
+                               "    size[0] = sizeof(Bvh4Node);\n"
+                               "    size[1] = __alignof__(Bvh4Node);\n"
+                               "}\n";
+    cl::Program program = build_program(device.context, device.info.device, source, "");
+    cl::Kernel k = make_kernel(program, "bvh4_node_size");
+    cl_int status;
+    cl::Buffer out(device.context, CL_MEM_WRITE_ONLY, 2 * sizeof(cl_uint), nullptr, &status);
+    CL_CHECK_STATUS(status, "clCreateBuffer");
+    CL_CHECK(k.setArg(0, out));
+    CL_CHECK(device.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(1)));
+    cl_uint got[2] = {};
+    CL_CHECK(device.queue.enqueueReadBuffer(out, CL_TRUE, 0, sizeof got, got));
+    CHECK(got[0] == sizeof(gpu::Bvh4Node));
+    CHECK(got[1] == alignof(gpu::Bvh4Node));
+}
+
+TEST_CASE("a deep 4-wide tree is traversed exactly (the stack bound holds)", "[traversal]") {
+    // Triangles scattered log-uniformly over 28 decades: SAH peels them off one scale at a time,
+    // giving a tree far deeper than log4(N), and rays from the origin cross every scale.
+    Scene scene;
+    uint32_t m = add_material(scene, glm::vec3(0.5f));
+    std::mt19937 rng(21);
+    std::uniform_real_distribution<float> decade(-14.0f, 14.0f), u(0.0f, 1.0f);
+    for (int t = 0; t < 4000; ++t) {
+        float x = std::pow(10.0f, decade(rng)), y = x * u(rng), z = x * u(rng), e = 0.2f * x;
+        add_triangle(scene, {x, y, z}, {x + e, y, z}, {x, y + e, z}, m);
+    }
+    Bvh bvh = build_bvh(scene);
+    INFO("binary depth " << bvh.stats.depth << ", 4-wide depth " << bvh.stats.depth4);
+    CHECK(bvh.stats.depth4 >= 30);
+    // Rays from near the origin at each triangle's centroid: they must hit it or something nearer.
+    RaySet rays;
+    for (size_t t = 0; t < scene.triangle_count(); ++t) {
+        glm::vec3 c =
+            (scene.positions[3 * t] + scene.positions[3 * t + 1] + scene.positions[3 * t + 2]) /
+            3.0f;
+        glm::vec3 o(-1e-20f, -2e-20f, -3e-20f), d = c - o;
+        rays.origins.push_back({o.x, o.y, o.z, FLT_MAX});
+        rays.directions.push_back({d.x, d.y, d.z, 0.0f});
+    }
+    Tracer tracer;
+    auto hits = tracer.run<gpu::float4>("trace_closest", bvh, rays);
+    auto occluded = tracer.run<cl_uint>("trace_any", bvh, rays);
+    size_t misses = 0, beyond = 0, not_occluded = 0;
+    for (size_t k = 0; k < hits.size(); ++k) {
+        not_occluded += occluded[k] == 0u;
+        if (bits(hits[k].w) == 0xffffffffu) {
+            ++misses;
+            continue;
+        }
+        beyond += hits[k].x > 1.0f + 1e-5f;  // the centroid is at t = 1
+    }
+    CHECK(misses == 0);
+    CHECK(beyond == 0);
+    CHECK(not_occluded == 0);
 }
 
 TEST_CASE("an empty scene is traversed without hits", "[traversal]") {

@@ -54,7 +54,7 @@ class DeviceTracer {
   public:
     DeviceTracer(const DeviceInfo& info, const Bvh& bvh) : device_(info) {
         program_ = cached_program(device_, "trace.cl", "");
-        nodes_ = upload(bvh.nodes.data(), bvh.nodes.size() * sizeof(gpu::BvhNode), "BVH nodes");
+        nodes_ = upload(bvh.nodes4.data(), bvh.nodes4.size() * sizeof(gpu::Bvh4Node), "BVH nodes");
         std::vector<gpu::Triangle> one(1);
         const auto& tris = bvh.triangles.empty() ? one : bvh.triangles;
         triangles_ = upload(tris.data(), tris.size() * sizeof(gpu::Triangle), "triangles");

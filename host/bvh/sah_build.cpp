@@ -1,5 +1,6 @@
 // Binned SAH BVH build over triangle centroids (Wald 2007, "On fast construction of SAH-based
-// bounding volume hierarchies"; PBRT 3rd ed. 4.3), flattened depth-first with siblings adjacent.
+// bounding volume hierarchies"; PBRT 3rd ed. 4.3), flattened depth-first with siblings adjacent,
+// then collapsed into the 4-wide tree of bvh4_collapse.cpp.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -490,8 +491,18 @@ Bvh Builder::build() {
         tri.p2 = {p[2].x, p[2].y, p[2].z, 0.0f};
     }
     fill_stats(bvh, depth);
-    bvh.stats.build_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+    // The device traverses the 4-wide collapse of this tree.
+    const auto collapse_start = std::chrono::steady_clock::now();
+    Bvh4 bvh4 = collapse_to_bvh4(bvh.nodes, traversal_cost_);
+    bvh.nodes4 = std::move(bvh4.nodes);
+    bvh.stats.depth4 = bvh4.depth;
+    bvh.stats.sah_cost4 = bvh4.sah_cost;
+    bvh.stats.bytes =
+        bvh.nodes4.size() * sizeof(gpu::Bvh4Node) + bvh.triangles.size() * sizeof(gpu::Triangle);
+    const auto end = std::chrono::steady_clock::now();
+    bvh.stats.collapse_seconds = std::chrono::duration<double>(end - collapse_start).count();
+    bvh.stats.build_seconds = std::chrono::duration<double>(end - start).count();
     return bvh;
 }
 
@@ -516,8 +527,6 @@ void Builder::fill_stats(Bvh& bvh, int depth) const {
     }
     s.sah_cost = cost;
     s.depth = depth;
-    s.bytes =
-        bvh.nodes.size() * sizeof(gpu::BvhNode) + bvh.triangles.size() * sizeof(gpu::Triangle);
 }
 
 }  // namespace

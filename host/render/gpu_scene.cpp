@@ -31,7 +31,7 @@ gpu::CameraGpu make_gpu_camera(const Camera& camera, int width, int height) {
 GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& camera, int width,
                             int height) {
     GpuSceneData data;
-    data.nodes = bvh.nodes;
+    data.nodes = bvh.nodes4;
     data.triangles = bvh.triangles;
     for (const Material& m : scene.materials) {
         gpu::Material g{};

@@ -17,7 +17,7 @@ namespace mcrt {
 enum class LightSelect { Uniform, Power, Alias };
 
 struct GpuSceneData {
-    std::vector<gpu::BvhNode> nodes;
+    std::vector<gpu::Bvh4Node> nodes;  // 4-wide, as the kernels traverse it
     std::vector<gpu::Triangle> triangles;
     std::vector<gpu::Material> materials;
     std::vector<gpu::Light> lights;
