@@ -70,7 +70,7 @@ inline float4 bvh4_entry(global const Bvh4Node* node, const BoxRay* b, float t_m
 /* Closest hit with t in (0, t_max). Children are visited nearest first; the others wait on the
  * stack with their entry distances and are skipped once a nearer hit is found. An empty scene's
  * root has only empty slots, so no ray enters it. */
-inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const Triangle* triangles,
+inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                            const Ray* r, float t_max) {
     Hit hit;
     hit.t = t_max;
@@ -78,10 +78,11 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const Triangle* 
     hit.triangle = NO_HIT;
 
     BoxRay b = make_box_ray(r);
+    PacketRay q = make_packet_ray(r);
     uint stack_ref[BVH_STACK_SIZE], stack_count[BVH_STACK_SIZE];
     float stack_t[BVH_STACK_SIZE];
     int sp = 0;
-    /* The current child: a Bvh4Node index when count is 0, else a leaf's first triangle. */
+    /* The current child: a Bvh4Node index when count is 0, else a leaf's first packet. */
     uint ref = 0u, count = 0u;
     for (;;) {
         if (count == 0u) {
@@ -113,14 +114,26 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const Triangle* 
                 continue;
             }
         } else {
-            for (uint i = ref; i < ref + count; ++i) {
-                float t, b1, b2;
-                if (intersect_triangle(r, triangles[i].p0, triangles[i].p1, triangles[i].p2, hit.t,
-                                       &t, &b1, &b2)) {
-                    hit.t = t;
-                    hit.b1 = b1;
-                    hit.b2 = b2;
-                    hit.triangle = i;
+            /* A leaf's packets, four triangles per test; within a test the lanes are taken in
+             * leaf order, a later one only if strictly nearer, as one at a time would. */
+            global const TrianglePacket* pk = packets + ref;
+            for (uint k = 0; k < count; k += MCRT_PACKET_WIDTH, ++pk) {
+                float4 t4, b1, b2;
+                int4 lanes = intersect_packet(&q, pk, hit.t, &t4, &b1, &b2);
+                if (!any(lanes)) continue;
+                int m[4];
+                float t[4], u[4], v[4];
+                vstore4(lanes, 0, m);
+                vstore4(t4, 0, t);
+                vstore4(b1, 0, u);
+                vstore4(b2, 0, v);
+                for (int i = 0; i < 4; ++i) {
+                    if (m[i] && t[i] < hit.t) {
+                        hit.t = t[i];
+                        hit.b1 = u[i];
+                        hit.b2 = v[i];
+                        hit.triangle = pk->index[i];
+                    }
                 }
             }
         }
@@ -141,9 +154,10 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const Triangle* 
  * bench's shadow rays this visited 6.7 nodes per ray in Sponza against 9.7 in slot order and 9.0
  * nearest first, but 8.3 against 5.5 in the modern hall (docs/BENCHMARKS.md, issue 6). No order
  * wins everywhere; this one gave the best worst-case ratio to Embree over the bench scenes. */
-inline bool bvh_any_hit(global const Bvh4Node* nodes, global const Triangle* triangles,
+inline bool bvh_any_hit(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                         const Ray* r, float t_max) {
     BoxRay b = make_box_ray(r);
+    PacketRay q = make_packet_ray(r);
     uint stack[BVH_STACK_SIZE];
     int sp = 0;
     uint ref = 0u;
@@ -158,11 +172,10 @@ inline bool bvh_any_hit(global const Bvh4Node* nodes, global const Triangle* tri
                 if (sp < BVH_STACK_SIZE) stack[sp++] = child;
                 continue;
             }
-            for (uint i = child; i < child + count; ++i) {
-                float t, b1, b2;
-                if (intersect_triangle(r, triangles[i].p0, triangles[i].p1, triangles[i].p2, t_max,
-                                       &t, &b1, &b2))
-                    return true;
+            global const TrianglePacket* pk = packets + child;
+            for (uint k = 0; k < count; k += MCRT_PACKET_WIDTH, ++pk) {
+                float4 t4, b1, b2;
+                if (any(intersect_packet(&q, pk, t_max, &t4, &b1, &b2))) return true;
             }
         }
         if (sp == 0) return false;

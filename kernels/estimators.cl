@@ -123,7 +123,7 @@ inline float3 emitted_along(const SceneView* scene, const SurfacePoint* sp, floa
                             SurfacePoint* seen) {
     *rays += 1u;
     Ray r = make_ray(offset_ray_origin(sp->p, sp->n), wi);
-    Hit hit = bvh_closest_hit(scene->nodes, scene->triangles, &r, MAXFLOAT);
+    Hit hit = bvh_closest_hit(scene->nodes, scene->packets, &r, MAXFLOAT);
     if (hit.triangle == NO_HIT) return (float3)(0.0f);
     *seen = surface_point(scene, &r, &hit);
     return emitted_radiance(seen);
@@ -219,7 +219,7 @@ inline float3 estimate_ambient(const SceneView* scene, const SurfacePoint* sp,
     Ray r = make_ray(offset_ray_origin(sp->p, sp->n), frame_to_world(&frame, w));
     *rays += 1u;
     float t_max = env->ao_distance > 0.0f ? env->ao_distance : MAXFLOAT;
-    if (bvh_any_hit(scene->nodes, scene->triangles, &r, t_max)) return (float3)(0.0f);
+    if (bvh_any_hit(scene->nodes, scene->packets, &r, t_max)) return (float3)(0.0f);
     return sp->material.albedo.xyz * env->sky * (MCRT_INV_PI * w.z / pdf_w);
 }
 
@@ -236,7 +236,7 @@ inline float3 estimate_ambient(const SceneView* scene, const SurfacePoint* sp,
 inline float3 radiance(const SceneView* scene, const Ray* r, const SampleStream* stream,
                        const Environment* env, uint* rays) {
     *rays += 1u;
-    Hit hit = bvh_closest_hit(scene->nodes, scene->triangles, r, MAXFLOAT);
+    Hit hit = bvh_closest_hit(scene->nodes, scene->packets, r, MAXFLOAT);
 #if defined(ESTIMATOR_AMBIENT)
     if (hit.triangle == NO_HIT) return env->sky;
 #else

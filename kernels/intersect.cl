@@ -53,6 +53,76 @@ inline bool intersect_triangle(const Ray* r, float4 p0, float4 p1, float4 p2, fl
     return true;
 }
 
+/* The ray as the four-lane test reads it: its origin on the permuted axes kx, ky, kz and its
+ * shear, splatted, and the permutation as indices into TrianglePacket.v. */
+typedef struct {
+    float4 org_x, org_y, org_z;
+    float4 shear_x, shear_y, shear_z;
+    uint kx, ky, kz;
+} PacketRay;
+
+inline PacketRay make_packet_ray(const Ray* r) {
+    PacketRay q;
+    float4 o = shuffle((float4)(r->org, 0.0f), r->shear_axes);
+    q.org_x = (float4)(o.x);
+    q.org_y = (float4)(o.y);
+    q.org_z = (float4)(o.z);
+    q.shear_x = (float4)(r->shear.x);
+    q.shear_y = (float4)(r->shear.y);
+    q.shear_z = (float4)(r->shear.z);
+    q.kx = r->shear_axes.x;
+    q.ky = r->shear_axes.y;
+    q.kz = r->shear_axes.z;
+    return q;
+}
+
+/* intersect_triangle on the four lanes of a packet at once: the same operations in the same
+ * order, lane by lane, so each lane's answer is bit for bit the scalar one (and as watertight).
+ * Returns a lane mask (-1 where a used lane is hit with t in (0, t_max)) and its t, b1, b2. */
+inline int4 intersect_packet(const PacketRay* q, global const TrianglePacket* pk, float t_max,
+                             float4* t_hit, float4* b1, float4* b2) {
+    global const float4* v = pk->v;
+    float4 a_x = v[q->kx] - q->org_x, a_y = v[q->ky] - q->org_y, a_z = v[q->kz] - q->org_z;
+    float4 b_x = v[3u + q->kx] - q->org_x, b_y = v[3u + q->ky] - q->org_y,
+           b_z = v[3u + q->kz] - q->org_z;
+    float4 c_x = v[6u + q->kx] - q->org_x, c_y = v[6u + q->ky] - q->org_y,
+           c_z = v[6u + q->kz] - q->org_z;
+    float4 ax = a_x - q->shear_x * a_z, ay = a_y - q->shear_y * a_z;
+    float4 bx = b_x - q->shear_x * b_z, by = b_y - q->shear_y * b_z;
+    float4 cx = c_x - q->shear_x * c_z, cy = c_y - q->shear_y * c_z;
+
+    float4 u = cx * by - cy * bx;
+    float4 w_ = bx * ay - by * ax;
+    float4 v_ = ax * cy - ay * cx;
+    int4 used = as_int4(vload4(0, pk->index)) != (int4)(-1);
+#ifdef MCRT_HAVE_FP64
+    int4 zero = used & ((u == 0.0f) | (v_ == 0.0f) | (w_ == 0.0f));
+    if (any(zero)) {
+        double4 dax = convert_double4(ax), day = convert_double4(ay);
+        double4 dbx = convert_double4(bx), dby = convert_double4(by);
+        double4 dcx = convert_double4(cx), dcy = convert_double4(cy);
+        u = select(u, convert_float4(dcx * dby - dcy * dbx), zero);
+        v_ = select(v_, convert_float4(dax * dcy - day * dcx), zero);
+        w_ = select(w_, convert_float4(dbx * day - dby * dax), zero);
+    }
+#endif
+    int4 negative = (u < 0.0f) | (v_ < 0.0f) | (w_ < 0.0f);
+    int4 positive = (u > 0.0f) | (v_ > 0.0f) | (w_ > 0.0f);
+    float4 det = u + v_ + w_;
+    int4 hit = used & ~(negative & positive) & (det != 0.0f);
+    if (!any(hit)) return hit;
+
+    float4 az = q->shear_z * a_z, bz = q->shear_z * b_z, cz = q->shear_z * c_z;
+    float4 t_scaled = u * az + v_ * bz + w_ * cz;
+    float4 inv_det = 1.0f / det;
+    float4 t = t_scaled * inv_det;
+    hit &= (t > 0.0f) & (t < (float4)(t_max));
+    *t_hit = t;
+    *b1 = v_ * inv_det;
+    *b2 = w_ * inv_det;
+    return hit;
+}
+
 /* Contraction is harmless, and faster, in the rest of the program. */
 #pragma OPENCL FP_CONTRACT ON
 #endif

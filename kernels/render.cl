@@ -6,7 +6,8 @@
 /* One work-item per pixel sample of a batch. Work-item g renders sample
  * sample_begin + g % batch_samples (of spp in all) of pixel pixel_begin + g / batch_samples
  * < pixel_end (samples of a pixel adjacent) and writes samples[g] = (radiance, rays traced). */
-kernel void render(global const Bvh4Node* nodes, global const Triangle* triangles,
+kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* packets,
+                   global const Triangle* triangles,
                    global const Material* materials, global const Light* lights,
                    global const float* light_cdf, global const AliasEntry* light_alias,
                    uint light_count, global const CameraGpu* camera, uint width, uint height,
@@ -25,6 +26,7 @@ kernel void render(global const Bvh4Node* nodes, global const Triangle* triangle
 
     SceneView scene;
     scene.nodes = nodes;
+    scene.packets = packets;
     scene.triangles = triangles;
     scene.materials = materials;
     scene.lights.lights = lights;
@@ -88,4 +90,6 @@ kernel void shared_type_sizes(global uint* sizes) {
     sizes[3] = sizeof(Light);
     sizes[4] = sizeof(CameraGpu);
     sizes[5] = sizeof(AliasEntry);
+    sizes[6] = sizeof(Bvh4Node);
+    sizes[7] = sizeof(TrianglePacket);
 }

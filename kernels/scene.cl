@@ -7,6 +7,7 @@
 
 typedef struct {
     global const Bvh4Node* nodes;
+    global const TrianglePacket* packets; /* the leaves' triangles, for ray queries */
     global const Triangle* triangles;
     global const Material* materials;
     LightSet lights;
@@ -45,7 +46,7 @@ inline bool visible(const SceneView* scene, float3 a, float3 na, float3 b, float
     float3 o = offset_ray_origin(a, na);
     float3 target = offset_ray_origin(b, nb);
     Ray shadow = make_ray(o, target - o);
-    return !bvh_any_hit(scene->nodes, scene->triangles, &shadow, 1.0f);
+    return !bvh_any_hit(scene->nodes, scene->packets, &shadow, 1.0f);
 }
 
 #endif

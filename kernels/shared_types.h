@@ -35,7 +35,9 @@ typedef struct {
  * in float4 arithmetic covers all four (Wald, Benthin, Boulos 2008, "Getting rid of packets";
  * Embree's BVH4). Slot i is
  *   - an inner child: count[i] == 0, child[i] = index of its Bvh4Node;
- *   - a leaf: count[i] = number of triangles (> 0), child[i] = first one in leaf order;
+ *   - a leaf: count[i] = number of triangles (> 0), child[i] = index of its first
+ *     TrianglePacket; the leaf's triangles fill packets child[i] .. child[i] + ceil(count/4) - 1
+ *     lane by lane, in leaf order;
  *   - empty: count[i] == 0, child[i] == 0 and an inverted box (lo = +1e30, hi = -1e30) that the
  *     traversal's sign-selected slab test always rejects (near plane beyond far plane).
  * nodes[0] is the root; an empty scene's root has four empty slots. */
@@ -46,6 +48,18 @@ typedef struct {
     uint child[4];     /* 96 */
     uint count[4];     /* 112 */
 } Bvh4Node;
+
+/* Up to four triangles of one leaf in SoA form, 160 bytes, so that one watertight test in float4
+ * arithmetic covers all four (Wald, Benthin, Boulos 2008; Embree's triangle4). v[3k + a] holds
+ * coordinate a (x, y, z) of vertex k of the four lanes; index[i] is lane i's triangle in leaf
+ * order (the Triangle array), NO_HIT (0xffffffff) for an unused lane, whose vertices are 0. */
+typedef struct {
+    float4 v[9];    /* 0: x0, y0, z0, x1, y1, z1, x2, y2, z2 */
+    uint index[4];  /* 144 */
+} TrianglePacket;
+
+/* Triangles per TrianglePacket: the SAH counts a leaf of N triangles as ceil(N / 4) tests. */
+#define MCRT_PACKET_WIDTH 4
 
 /* Longest root-to-leaf path of Bvh4Node (counting inner Bvh4Nodes): every Bvh4Node is an inner
  * node of the binary tree, so at most MCRT_BVH_MAX_DEPTH - 1 of them lie on a path. */
@@ -100,6 +114,7 @@ typedef struct {
 #ifndef __OPENCL_VERSION__
 static_assert(sizeof(BvhNode) == 32 && alignof(BvhNode) == 16, "BvhNode layout");
 static_assert(sizeof(Bvh4Node) == 128 && alignof(Bvh4Node) == 16, "Bvh4Node layout");
+static_assert(sizeof(TrianglePacket) == 160 && alignof(TrianglePacket) == 16, "TrianglePacket layout");
 static_assert(sizeof(Triangle) == 48 && alignof(Triangle) == 16, "Triangle layout");
 static_assert(sizeof(Material) == 48 && alignof(Material) == 16, "Material layout");
 static_assert(sizeof(Light) == 64 && alignof(Light) == 16, "Light layout");

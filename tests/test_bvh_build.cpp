@@ -162,7 +162,7 @@ double sah_cost(const Bvh& bvh, float traversal_cost) {
     for (const gpu::BvhNode& n : bvh.nodes) {
         double ratio = root > 0 ? box_of(n).area() / root : 1.0;
         bool inner = node_count(n) == 0 && bvh.nodes.size() > 1;
-        cost += (inner ? traversal_cost : double(node_count(n))) * ratio;
+        cost += (inner ? traversal_cost : double(packets_for(node_count(n)))) * ratio;
     }
     return cost;
 }
@@ -189,7 +189,8 @@ bool is_empty_slot(const gpu::Bvh4Node& n, int s) {
 void validate4(const Bvh& bvh, const BvhBuildOptions& options) {
     const size_t n = bvh.triangles.size();
     REQUIRE(!bvh.nodes4.empty());
-    std::vector<int> reached(bvh.nodes4.size(), 0), covered(n, 0);
+    std::vector<int> reached(bvh.nodes4.size(), 0), covered(n, 0),
+        packet_uses(bvh.packets.size(), 0);
     std::vector<std::pair<uint32_t, uint32_t>> leaves4, leaves2;
     size_t problems = 0, infinite = 0, lonely = 0;
     int depth = 0;
@@ -226,10 +227,36 @@ void validate4(const Bvh& bvh, const BvhBuildOptions& options) {
                 stack.push_back({node.child[s], item.level + 1, b, true});
                 continue;
             }
-            const uint32_t first = node.child[s], count = node.count[s];
-            if (count > uint32_t(options.max_leaf_size) || size_t(first) + count > n) {
+            // The slot names the leaf's first packet; its lanes name the triangles in leaf order.
+            const uint32_t packet = node.child[s], count = node.count[s];
+            if (count > uint32_t(options.max_leaf_size) ||
+                size_t(packet) + packets_for(count) > bvh.packets.size()) {
                 ++problems;
                 continue;
+            }
+            const uint32_t first = bvh.packets[packet].index[0];
+            if (size_t(first) + count > n) {
+                ++problems;
+                continue;
+            }
+            for (uint32_t k = 0; k < packets_for(count); ++k) {
+                const gpu::TrianglePacket& p = bvh.packets[packet + k];
+                ++packet_uses[packet + k];
+                for (uint32_t i = 0; i < MCRT_PACKET_WIDTH; ++i) {
+                    const uint32_t j = k * MCRT_PACKET_WIDTH + i;  // the leaf's j-th triangle
+                    if (j >= count) {  // unused lanes: no triangle, vertices 0
+                        if (p.index[i] != 0xffffffffu) ++problems;
+                        for (int v = 0; v < 9; ++v) problems += lane(p.v[v], int(i)) != 0.0f;
+                        continue;
+                    }
+                    if (p.index[i] != first + j) ++problems;
+                    const gpu::Triangle& t = bvh.triangles[first + j];
+                    const gpu::float4* q[3] = {&t.p0, &t.p1, &t.p2};
+                    for (int v = 0; v < 3; ++v)
+                        problems += lane(p.v[3 * v], int(i)) != q[v]->x ||
+                                    lane(p.v[3 * v + 1], int(i)) != q[v]->y ||
+                                    lane(p.v[3 * v + 2], int(i)) != q[v]->z;
+                }
             }
             leaves4.push_back({first, count});
             Box tight;
@@ -244,11 +271,11 @@ void validate4(const Bvh& bvh, const BvhBuildOptions& options) {
         if (item.from_parent && (!same_box(u, item.box) || used < 2)) ++problems;
         if (!item.from_parent) root_area = u.area();  // the root comes first
         lonely += item.from_parent && used < 2;
-        // SAH cost (PBRT 4.3.2): a node visit costs traversal_cost, a leaf its triangles.
+        // SAH cost (PBRT 4.3.2): a node visit costs traversal_cost, a leaf its packets.
         auto weight = [&](const Box& b) { return root_area > 0 ? b.area() / root_area : 1.0; };
         if (used > 0) cost += options.traversal_cost * weight(u);
         for (int s = 0; s < 4; ++s)
-            if (node.count[s] > 0) cost += node.count[s] * weight(slot_box(node, s));
+            if (node.count[s] > 0) cost += packets_for(node.count[s]) * weight(slot_box(node, s));
     }
     for (const gpu::BvhNode& node : bvh.nodes)
         if (node_count(node) > 0) leaves2.push_back({node_first(node), node_count(node)});
@@ -260,11 +287,16 @@ void validate4(const Bvh& bvh, const BvhBuildOptions& options) {
     CHECK(leaves4 == leaves2);
     CHECK(std::count(reached.begin(), reached.end(), 1) == std::ptrdiff_t(bvh.nodes4.size()));
     CHECK(std::count(covered.begin(), covered.end(), 1) == std::ptrdiff_t(n));
+    CHECK(std::count(packet_uses.begin(), packet_uses.end(), 1) ==
+          std::ptrdiff_t(bvh.packets.size()));
+    CHECK(bvh.stats.packets == bvh.packets.size());
     CHECK(depth == bvh.stats.depth4);
     CHECK(depth <= kMaxBvh4Depth);
     CHECK(depth <= std::max(1, bvh.stats.depth - 1));
     CHECK(bvh.stats.sah_cost4 == Approx(cost).epsilon(1e-6));
-    CHECK(bvh.stats.bytes == bvh.nodes4.size() * sizeof(gpu::Bvh4Node) + n * sizeof(gpu::Triangle));
+    CHECK(bvh.stats.bytes == bvh.nodes4.size() * sizeof(gpu::Bvh4Node) +
+                                 bvh.packets.size() * sizeof(gpu::TrianglePacket) +
+                                 n * sizeof(gpu::Triangle));
     if (n == 0) {
         for (int s = 0; s < 4; ++s) CHECK(is_empty_slot(bvh.nodes4[0], s));
         CHECK(bvh.stats.sah_cost4 == 0.0);
@@ -454,7 +486,8 @@ Hit traverse4(const Bvh& bvh, const Ray& ray, bool& overflow) {
                 stack.push_back(node.child[s]);
                 continue;
             }
-            for (uint32_t i = node.child[s]; i < node.child[s] + node.count[s]; ++i) {
+            const uint32_t first = bvh.packets[node.child[s]].index[0];
+            for (uint32_t i = first; i < first + node.count[s]; ++i) {
                 const gpu::Triangle& tri = bvh.triangles[i];
                 float t =
                     intersect(ray, {tri.p0.x, tri.p0.y, tri.p0.z}, {tri.p1.x, tri.p1.y, tri.p1.z},

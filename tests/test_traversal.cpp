@@ -42,11 +42,11 @@ struct Tracer {
         cl::Kernel k = make_kernel(program, entry);
         std::vector<Out> out(rays.origins.size());
         cl::Buffer nodes = buffer(bvh.nodes4),
-                   tris = buffer(bvh.triangles.empty() ? std::vector<gpu::Triangle>(1)
-                                                       : bvh.triangles);
+                   packets = buffer(bvh.packets.empty() ? std::vector<gpu::TrianglePacket>(1)
+                                                        : bvh.packets);
         cl::Buffer o = buffer(rays.origins), d = buffer(rays.directions), result = buffer(out);
         CL_CHECK(k.setArg(0, nodes));
-        CL_CHECK(k.setArg(1, tris));
+        CL_CHECK(k.setArg(1, packets));
         CL_CHECK(k.setArg(2, o));
         CL_CHECK(k.setArg(3, d));
         CL_CHECK(k.setArg(4, cl_uint(out.size())));

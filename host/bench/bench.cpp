@@ -55,9 +55,10 @@ class DeviceTracer {
     DeviceTracer(const DeviceInfo& info, const Bvh& bvh) : device_(info) {
         program_ = cached_program(device_, "trace.cl", "");
         nodes_ = upload(bvh.nodes4.data(), bvh.nodes4.size() * sizeof(gpu::Bvh4Node), "BVH nodes");
-        std::vector<gpu::Triangle> one(1);
-        const auto& tris = bvh.triangles.empty() ? one : bvh.triangles;
-        triangles_ = upload(tris.data(), tris.size() * sizeof(gpu::Triangle), "triangles");
+        std::vector<gpu::TrianglePacket> one(1);
+        const auto& packets = bvh.packets.empty() ? one : bvh.packets;
+        packets_ = upload(packets.data(), packets.size() * sizeof(gpu::TrianglePacket),
+                          "triangle packets");
     }
 
     const DeviceInfo& info() const { return device_.info; }
@@ -118,7 +119,7 @@ class DeviceTracer {
         CL_CHECK_STATUS(status, "clCreateBuffer");
         cl::Kernel kernel = make_kernel(program_, entry);
         CL_CHECK(kernel.setArg(0, nodes_));
-        CL_CHECK(kernel.setArg(1, triangles_));
+        CL_CHECK(kernel.setArg(1, packets_));
         CL_CHECK(kernel.setArg(2, origins));
         CL_CHECK(kernel.setArg(3, directions));
         CL_CHECK(kernel.setArg(4, cl_uint(n)));
@@ -150,7 +151,7 @@ class DeviceTracer {
 
     DeviceContext device_;
     cl::Program program_;
-    cl::Buffer nodes_, triangles_;
+    cl::Buffer nodes_, packets_;
 };
 
 // One row of the report.
@@ -179,7 +180,7 @@ int run_bench(const BenchOptions& o, const std::function<void(const std::string&
     Camera camera = scene.cameras.empty() ? bench_camera(scene) : scene.cameras.front();
     BenchFrame frame = bench_frame(scene);
 
-    Bvh bvh = build_bvh(scene);
+    Bvh bvh = build_bvh(scene, o.bvh);
     double bytes_per_triangle =
         scene.triangle_count() ? double(bvh.stats.bytes) / double(scene.triangle_count()) : 0.0;
     DeviceTracer tracer(devices[size_t(o.device)], bvh);
@@ -265,7 +266,10 @@ int run_bench(const BenchOptions& o, const std::function<void(const std::string&
                 {"device", tracer.info().name},
                 {"triangles", scene.triangle_count()},
                 {"bvh_build_seconds", bvh.stats.build_seconds},
-                {"sah_cost", bvh.stats.sah_cost},
+                {"sah_cost", bvh.stats.sah_cost4},
+                {"bvh_depth", bvh.stats.depth4},
+                {"bvh_nodes", bvh.nodes4.size()},
+                {"bvh_packets", bvh.stats.packets},
                 {"bytes_per_triangle", bytes_per_triangle},
             };
 #ifdef MCRT_HAVE_EMBREE
@@ -287,8 +291,11 @@ int run_bench(const BenchOptions& o, const std::function<void(const std::string&
     std::printf("scene %s: %zu triangles, %s camera, %dx%d, device %d: %s\n", o.scene.c_str(),
                 scene.triangle_count(), scene.cameras.empty() ? "bench" : "its first", o.width,
                 o.height, o.device, tracer.info().name.c_str());
-    std::printf("mcrt BVH: built in %.3f s, SAH cost %.2f, %.1f bytes per triangle, depth %d\n",
-                bvh.stats.build_seconds, bvh.stats.sah_cost, bytes_per_triangle, bvh.stats.depth);
+    std::printf(
+        "mcrt BVH4: built in %.3f s, SAH cost %.2f, depth %d, %zu nodes, %zu packets, %.1f bytes "
+        "per triangle\n",
+        bvh.stats.build_seconds, bvh.stats.sah_cost4, bvh.stats.depth4, bvh.nodes4.size(),
+        bvh.stats.packets, bytes_per_triangle);
 #ifdef MCRT_HAVE_EMBREE
     std::printf("Embree %s: built in %.3f s (default quality), %u threads, single-ray API\n",
                 embree.version().c_str(), embree.build_seconds(), embree.threads());

@@ -5,6 +5,8 @@
 #include <functional>
 #include <string>
 
+#include "bvh/bvh.h"
+
 namespace mcrt {
 
 struct BenchOptions {
@@ -14,6 +16,7 @@ struct BenchOptions {
     int repeats = 5;    // timed launches after one warm-up; the median is reported
     int device = 0;     // index from `mcrt devices`
     bool json = false;  // one JSON object per ray kind and line instead of a table
+    BvhBuildOptions bvh;  // SAH build options, for experiments with the tree's shape
 };
 
 // Runs the benchmark and prints its results on stdout; returns the exit status. Throws

@@ -143,7 +143,7 @@ Bvh4 collapse_to_bvh4(const std::vector<gpu::BvhNode>& nodes, float traversal_co
         throw RuntimeError("BVH4 collapse: depth " + std::to_string(out.depth) +
                            " exceeds the traversal stack's bound " + std::to_string(kMaxBvh4Depth));
 
-    // SAH cost: each node visit costs traversal_cost, each leaf its triangles, weighted by the
+    // SAH cost: each node visit costs traversal_cost, each leaf its packets, weighted by the
     // probability A / A_root that a ray through the root enters it (PBRT 3rd ed. 4.3.2).
     const double root_area = union_area(out.nodes[0]);
     auto ratio = [&](double a) { return root_area > 0.0 ? a / root_area : 1.0; };
@@ -154,7 +154,7 @@ Bvh4 collapse_to_bvh4(const std::vector<gpu::BvhNode>& nodes, float traversal_co
             if (node.count[s] == 0) continue;
             const float lo[3] = {lane(node.lo_x, s), lane(node.lo_y, s), lane(node.lo_z, s)};
             const float hi[3] = {lane(node.hi_x, s), lane(node.hi_y, s), lane(node.hi_z, s)};
-            cost += node.count[s] * ratio(area(lo, hi));
+            cost += packets_for(node.count[s]) * ratio(area(lo, hi));
         }
     }
     // An empty scene's root is never entered: it costs nothing.
@@ -162,6 +162,39 @@ Bvh4 collapse_to_bvh4(const std::vector<gpu::BvhNode>& nodes, float traversal_co
     const bool empty = lane(root.lo_x, 0) > lane(root.hi_x, 0);
     out.sah_cost = empty ? 0.0 : cost;
     return out;
+}
+
+std::vector<gpu::TrianglePacket> pack_leaves(std::vector<gpu::Bvh4Node>& nodes,
+                                             const std::vector<gpu::Triangle>& triangles) {
+    std::vector<gpu::TrianglePacket> packets;
+    packets.reserve(triangles.size() / 2 + 1);
+    for (gpu::Bvh4Node& node : nodes) {
+        for (int s = 0; s < 4; ++s) {
+            const uint32_t first = node.child[s], count = node.count[s];
+            if (count == 0) continue;  // inner or empty
+            if (size_t(first) + count > triangles.size())
+                throw RuntimeError("BVH packets: a leaf's triangles run past the triangle array");
+            if (packets.size() + packets_for(count) >= size_t(UINT32_MAX))
+                throw RuntimeError("BVH packets: too many packets for 32-bit indices");
+            node.child[s] = uint32_t(packets.size());
+            for (uint32_t k = 0; k < count; k += MCRT_PACKET_WIDTH) {
+                gpu::TrianglePacket p{};  // unused lanes: vertices 0, index NO_HIT
+                for (int i = 0; i < MCRT_PACKET_WIDTH; ++i) p.index[i] = 0xffffffffu;
+                for (uint32_t i = 0; i < MCRT_PACKET_WIDTH && k + i < count; ++i) {
+                    const gpu::Triangle& t = triangles[first + k + i];
+                    const gpu::float4* v[3] = {&t.p0, &t.p1, &t.p2};
+                    for (int j = 0; j < 3; ++j) {
+                        set_lane(p.v[3 * j + 0], int(i), v[j]->x);
+                        set_lane(p.v[3 * j + 1], int(i), v[j]->y);
+                        set_lane(p.v[3 * j + 2], int(i), v[j]->z);
+                    }
+                    p.index[i] = first + k + i;
+                }
+                packets.push_back(p);
+            }
+        }
+    }
+    return packets;
 }
 
 }  // namespace mcrt

@@ -263,7 +263,7 @@ SahSplit Builder::find_sah_split(const Task& task, Scratch& scratch) {
                 box[k][i] = Bounds{};
                 count[k][i] = 0;
             }
-            const double cost = area * n + right_area[i] * right_count[i];
+            const double cost = area * packets_for(n) + right_area[i] * packets_for(right_count[i]);
             if (cost < best.cost) {
                 best.axis = k;
                 best.bin = i;
@@ -357,7 +357,8 @@ void Builder::build_subtree(Task root, std::vector<gpu::BvhNode>& nodes, Scratch
             const double area = node_box(nodes[task.node]).area();
             split = find_sah_split(task, scratch);
             leaf = count <= max_leaf_ &&
-                   (split.axis < 0 || double(count) * area <= traversal_cost_ * area + split.cost);
+                   (split.axis < 0 ||
+                    double(packets_for(count)) * area <= traversal_cost_ * area + split.cost);
         }
         if (leaf) {
             set_first_count(nodes[task.node], task.begin, count);
@@ -492,21 +493,25 @@ Bvh Builder::build() {
     }
     fill_stats(bvh, depth);
 
-    // The device traverses the 4-wide collapse of this tree.
+    // The device traverses the 4-wide collapse of this tree, its leaves in packets.
     const auto collapse_start = std::chrono::steady_clock::now();
     Bvh4 bvh4 = collapse_to_bvh4(bvh.nodes, traversal_cost_);
     bvh.nodes4 = std::move(bvh4.nodes);
+    bvh.packets = pack_leaves(bvh.nodes4, bvh.triangles);
     bvh.stats.depth4 = bvh4.depth;
     bvh.stats.sah_cost4 = bvh4.sah_cost;
-    bvh.stats.bytes =
-        bvh.nodes4.size() * sizeof(gpu::Bvh4Node) + bvh.triangles.size() * sizeof(gpu::Triangle);
+    bvh.stats.packets = bvh.packets.size();
+    bvh.stats.bytes = bvh.nodes4.size() * sizeof(gpu::Bvh4Node) +
+                      bvh.packets.size() * sizeof(gpu::TrianglePacket) +
+                      bvh.triangles.size() * sizeof(gpu::Triangle);
     const auto end = std::chrono::steady_clock::now();
     bvh.stats.collapse_seconds = std::chrono::duration<double>(end - collapse_start).count();
     bvh.stats.build_seconds = std::chrono::duration<double>(end - start).count();
     return bvh;
 }
 
-// SAH cost of the final tree: inner nodes cost traversal_cost, leaves N, weighted by A/A_root.
+// SAH cost of the final tree: inner nodes cost traversal_cost, leaves their packets, weighted by
+// A/A_root.
 void Builder::fill_stats(Bvh& bvh, int depth) const {
     BvhStats& s = bvh.stats;
     const double root_area = node_box(bvh.nodes[0]).area();
@@ -521,7 +526,7 @@ void Builder::fill_stats(Bvh& bvh, int depth) const {
             cost += traversal_cost_ * ratio;
             ++s.inner_nodes;
         } else {
-            cost += count * ratio;
+            cost += packets_for(count) * ratio;
             ++s.leaves;
         }
     }

@@ -253,8 +253,12 @@ int run_render(const RenderOptions& o) {
             {"nan_samples", result.nan_samples},
             {"triangles", scene.triangle_count()},
             {"lights", gpu_scene.lights.size()},
-            {"bvh", {{"nodes", bvh.nodes.size()}, {"sah_cost", bvh.stats.sah_cost},
-                     {"depth", bvh.stats.depth}, {"bytes", bvh.stats.bytes}}},
+            // The 4-wide tree the kernels traverse; the binary SAH tree it collapses as binary_*.
+            {"bvh", {{"nodes", bvh.nodes4.size()}, {"packets", bvh.stats.packets},
+                     {"sah_cost", bvh.stats.sah_cost4}, {"depth", bvh.stats.depth4},
+                     {"bytes", bvh.stats.bytes}, {"binary_nodes", bvh.nodes.size()},
+                     {"binary_sah_cost", bvh.stats.sah_cost}, {"binary_depth", bvh.stats.depth},
+                     {"build_seconds", bvh.stats.build_seconds}}},
         };
         // Image-wide means, so that scripts can compare renders without reading EXR.
         std::array<double, 3> mean{}, mean_variance{};
@@ -335,6 +339,11 @@ int run_cli(int argc, char** argv) {
     bench_cmd->add_option("--device", bench_options.device, "device index from `mcrt devices`")
         ->capture_default_str()->check(CLI::Range(0, 1 << 30));
     bench_cmd->add_flag("--json", bench_options.json, "one JSON object per ray kind and line");
+    bench_cmd->add_option("--bvh-max-leaf", bench_options.bvh.max_leaf_size, "most triangles in a BVH leaf")
+        ->capture_default_str()->check(CLI::Range(1, 64));
+    bench_cmd->add_option("--bvh-traversal-cost", bench_options.bvh.traversal_cost,
+                          "SAH cost of a node visit, in packet tests")
+        ->capture_default_str()->check(kFinite)->check(CLI::Range(0.0f, 100.0f));
     IntegrateOptions integrate_options;
     add_integrate_command(app, integrate_options);
 

@@ -32,6 +32,7 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
                             int height) {
     GpuSceneData data;
     data.nodes = bvh.nodes4;
+    data.packets = bvh.packets;
     data.triangles = bvh.triangles;
     for (const Material& m : scene.materials) {
         gpu::Material g{};
@@ -90,6 +91,7 @@ static cl::Buffer upload(const DeviceContext& device, const std::vector<T>& item
 
 GpuSceneBuffers::GpuSceneBuffers(const DeviceContext& device, const GpuSceneData& data) {
     nodes = upload(device, data.nodes, bytes, "BVH nodes");
+    packets = upload(device, data.packets, bytes, "triangle packets");
     triangles = upload(device, data.triangles, bytes, "triangles");
     materials = upload(device, data.materials, bytes, "materials");
     lights = upload(device, data.lights, bytes, "lights");
