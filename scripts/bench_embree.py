@@ -2,7 +2,7 @@
 """mcrt against Embree: the table of docs/BENCHMARKS.md, from `mcrt bench --json` runs.
 
 Usage: scripts/bench_embree.py [--rounds R] [--size WxH] [--repeats K] [--scenes S ...]
-                               [-- EXTRA BENCH OPTIONS]
+                               [--mcrt BINARY] [-- EXTRA BENCH OPTIONS]
 Runs build/mcrt bench on each scene R times (scenes taken in turn, round by round, so that a
 change in the machine's load spreads over all of them) and prints one Markdown row per scene
 and ray kind: medians over the rounds of mcrt's and Embree's Mrays/s and of the ratio measured
@@ -28,12 +28,12 @@ def load_average():
 
 
 def bench(scene, args, extra):
-    cmd = [os.path.join(ROOT, "build", "mcrt"), "bench", scene, "--json", "--width",
+    cmd = [args.mcrt, "bench", scene, "--json", "--width",
            str(args.width), "--height", str(args.height), "--repeats", str(args.repeats)] + extra
     out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
     lines = [json.loads(line) for line in out.splitlines() if line.strip()]
     if any("embree_mrays_per_s" not in j for j in lines):
-        raise SystemExit("bench_embree.py: build/mcrt was built without Embree")
+        raise SystemExit(f"bench_embree.py: {args.mcrt} was built without Embree")
     return {j["rays"]: j for j in lines}
 
 
@@ -43,6 +43,7 @@ def main():
     p.add_argument("--size", default="1024x1024")
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--scenes", nargs="+", default=[os.path.join(SHARED, s) for s in SCENES])
+    p.add_argument("--mcrt", default=os.path.join(ROOT, "build", "mcrt"), help="the binary")
     p.add_argument("extra", nargs="*", help="further `mcrt bench` options, after --")
     args = p.parse_args()
     args.width, args.height = (int(v) for v in args.size.split("x"))
@@ -70,7 +71,7 @@ def main():
             name = f"{os.path.basename(s)} ({js[0]['triangles']:,})" if first else ""
             build = (f"{med(j['bvh_build_seconds'] for j in js):.3f} | "
                      f"{med(j['embree_build_seconds'] for j in js):.3f} | "
-                     f"{js[0]['sah_cost']:.2f} | {js[0]['bvh_packets']:,} | "
+                     f"{js[0]['sah_cost']:.2f} | {js[0].get('bvh_packets', '-')} | "
                      f"{js[0]['bytes_per_triangle']:.1f}") if first else "| | | |"
             tri = str(max(j.get("triangle_mismatches", 0) for j in js)) \
                 if kind == "primary" else "-"
