@@ -56,8 +56,15 @@ TEST_CASE("bench --json prints one consistent line per ray kind", "[bench]") {
     for (const auto& [kind, j] : lines) {
         INFO(kind << ": " << j.dump());
         for (const char* key : {"scene", "rays", "count", "hits", "mrays_per_s", "seconds_median",
-                                "bvh_build_seconds", "sah_cost", "bytes_per_triangle"})
+                                "bvh_build_seconds", "sah_cost", "bvh_depth", "bvh_nodes",
+                                "bvh_packets", "triangles", "bytes_per_triangle"})
             REQUIRE(j.contains(key));
+        // A packet holds one to four triangles of one leaf.
+        const long long triangles = j["triangles"], packets = j["bvh_packets"];
+        CHECK(packets >= (triangles + 3) / 4);
+        CHECK(packets <= triangles);
+        CHECK(j["bvh_depth"].get<int>() >= 1);
+        CHECK(j["bvh_nodes"].get<long long>() >= 1);
         CHECK(j["scene"] == kCornell);
         CHECK(j["hits"].get<long long>() >= 0);
         CHECK(j["hits"].get<long long>() <= j["count"].get<long long>());
@@ -110,6 +117,32 @@ TEST_CASE("bench --rays runs one kind; the table is the default output", "[bench
     CHECK(table.out.find("Mrays/s") != std::string::npos);
 }
 
+TEST_CASE("bench --bvh-max-leaf and --bvh-traversal-cost shape the tree, not the hits", "[bench]") {
+    auto primary = [](std::vector<std::string> extra) {
+        std::vector<std::string> args = {kCornell, "--rays", "primary", "--width", "48",
+                                         "--height", "48", "--repeats", "1", "--json"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        ProcessResult r = run_bench(args);
+        INFO(r.err);
+        REQUIRE(r.exit_code == 0);
+        auto lines = parse_lines(r.out);
+        REQUIRE(lines.count("primary") == 1);
+        return lines["primary"];
+    };
+    const auto standard = primary({});
+    const auto single = primary({"--bvh-max-leaf", "1"});
+    const auto free_nodes = primary({"--bvh-traversal-cost", "0"});
+    // Leaves of one triangle: a packet per triangle, one lane used in each.
+    CHECK(single["bvh_packets"] == single["triangles"]);
+    // The default fills the box's 36 triangles into the fewest packets, 9; node visits priced
+    // at nothing split wherever the SAH does not lose, so more, emptier packets and more nodes.
+    CHECK(standard["bvh_packets"] == 9);
+    CHECK(free_nodes["bvh_packets"].get<long long>() > standard["bvh_packets"].get<long long>());
+    CHECK(free_nodes["bvh_nodes"].get<long long>() > standard["bvh_nodes"].get<long long>());
+    CHECK(single["hits"] == standard["hits"]);
+    CHECK(free_nodes["hits"] == standard["hits"]);
+}
+
 TEST_CASE("bench rejects bad input with exit status 2", "[bench]") {
     const std::vector<std::vector<std::string>> bad = {
         {kCornell, "--rays", "diffuse"},
@@ -119,6 +152,9 @@ TEST_CASE("bench rejects bad input with exit status 2", "[bench]") {
         {kCornell, "--repeats", "1001"},
         {kCornell, "--device", "999"},
         {kCornell, "--bogus"},
+        {kCornell, "--bvh-max-leaf", "0"},
+        {kCornell, "--bvh-traversal-cost", "nan"},
+        {kCornell, "--bvh-traversal-cost", "-1"},
         {std::string(MCRT_SCENES) + "/no-such-scene.gltf"},
         {},
     };
