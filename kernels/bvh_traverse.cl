@@ -21,7 +21,8 @@
 typedef struct {
     float t;
     float b1, b2;  /* barycentrics of p1, p2 */
-    uint triangle; /* index in the leaf-ordered triangle array, NO_HIT on a miss */
+    uint triangle; /* packet lane of the hit, 4 · packet + lane (TriangleInfo's index), NO_HIT
+                      on a miss */
 } Hit;
 
 /* The ray as the 4-wide slab test reads it: origin and inverse direction splatted, and per axis
@@ -132,7 +133,7 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePa
                         hit.t = t[i];
                         hit.b1 = u[i];
                         hit.b2 = v[i];
-                        hit.triangle = pk->index[i];
+                        hit.triangle = MCRT_PACKET_WIDTH * (ref + k / MCRT_PACKET_WIDTH) + i;
                     }
                 }
             }

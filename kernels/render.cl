@@ -7,7 +7,7 @@
  * sample_begin + g % batch_samples (of spp in all) of pixel pixel_begin + g / batch_samples
  * < pixel_end (samples of a pixel adjacent) and writes samples[g] = (radiance, rays traced). */
 kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* packets,
-                   global const Triangle* triangles,
+                   global const TriangleInfo* triangle_info,
                    global const Material* materials, global const Light* lights,
                    global const float* light_cdf, global const AliasEntry* light_alias,
                    uint light_count, global const CameraGpu* camera, uint width, uint height,
@@ -27,7 +27,7 @@ kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* pa
     SceneView scene;
     scene.nodes = nodes;
     scene.packets = packets;
-    scene.triangles = triangles;
+    scene.triangle_info = triangle_info;
     scene.materials = materials;
     scene.lights.lights = lights;
     scene.lights.light_cdf = light_cdf;
@@ -92,4 +92,5 @@ kernel void shared_type_sizes(global uint* sizes) {
     sizes[5] = sizeof(AliasEntry);
     sizes[6] = sizeof(Bvh4Node);
     sizes[7] = sizeof(TrianglePacket);
+    sizes[8] = sizeof(TriangleInfo);
 }

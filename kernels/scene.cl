@@ -8,7 +8,7 @@
 typedef struct {
     global const Bvh4Node* nodes;
     global const TrianglePacket* packets; /* the leaves' triangles, for ray queries */
-    global const Triangle* triangles;
+    global const TriangleInfo* triangle_info; /* per packet lane: material, light */
     global const Material* materials;
     LightSet lights;
 } SceneView;
@@ -23,15 +23,20 @@ typedef struct {
 } SurfacePoint;
 
 inline SurfacePoint surface_point(const SceneView* scene, const Ray* r, const Hit* hit) {
-    Triangle tri = scene->triangles[hit->triangle];
-    float3 p0 = tri.p0.xyz, e1 = tri.p1.xyz - p0, e2 = tri.p2.xyz - p0;
+    /* The vertices from the hit's packet lane: coordinate a of vertex k at v[3k + a].lane. */
+    uint lane = hit->triangle % MCRT_PACKET_WIDTH;
+    global const float* v =
+        (global const float*)scene->packets[hit->triangle / MCRT_PACKET_WIDTH].v + lane;
+    float3 p0 = (float3)(v[0], v[4], v[8]);
+    float3 e1 = (float3)(v[12], v[16], v[20]) - p0, e2 = (float3)(v[24], v[28], v[32]) - p0;
+    TriangleInfo info = scene->triangle_info[hit->triangle];
     SurfacePoint sp;
     sp.p = p0 + hit->b1 * e1 + hit->b2 * e2;
     float3 ng = normalize(cross(e1, e2));
     sp.front = dot(ng, r->dir) < 0.0f;
     sp.n = sp.front ? ng : -ng;
-    sp.light = as_uint(tri.p2.w);
-    sp.material = scene->materials[as_uint(tri.p0.w)];
+    sp.light = info.light;
+    sp.material = scene->materials[info.material];
     return sp;
 }
 

@@ -61,13 +61,21 @@ typedef struct {
 /* Triangles per TrianglePacket: the SAH counts a leaf of N triangles as ceil(N / 4) tests. */
 #define MCRT_PACKET_WIDTH 4
 
+/* What shading needs of a hit triangle besides its vertices (which it reads from the packet),
+ * 8 bytes, one per packet lane: info[4 · packet + lane]; unused lanes hold zeros. */
+typedef struct {
+    uint material; /* index into the materials */
+    uint light;    /* index of its Light plus one, 0 when it is not a light */
+} TriangleInfo;
+
 /* Longest root-to-leaf path of Bvh4Node (counting inner Bvh4Nodes): every Bvh4Node is an inner
  * node of the binary tree, so at most MCRT_BVH_MAX_DEPTH - 1 of them lie on a path. */
 #define MCRT_BVH4_MAX_DEPTH (MCRT_BVH_MAX_DEPTH - 1)
 
-/* Triangle in BVH leaf order, 48 bytes: world-space vertices, counter-clockwise seen from the
- * front. p0.w holds the material index as uint bits; p1.w the scene's triangle index; p2.w the
- * index of its Light plus one, 0 when it is not a light (uint bits). */
+/* Triangle in BVH leaf order, 48 bytes, on the host (Bvh::triangles; the device reads vertices
+ * from TrianglePacket and the rest from TriangleInfo): world-space vertices, counter-clockwise
+ * seen from the front. p0.w holds the material index as uint bits; p1.w the scene's triangle
+ * index; p2.w is 0. */
 typedef struct {
     float4 p0;
     float4 p1;
@@ -115,6 +123,7 @@ typedef struct {
 static_assert(sizeof(BvhNode) == 32 && alignof(BvhNode) == 16, "BvhNode layout");
 static_assert(sizeof(Bvh4Node) == 128 && alignof(Bvh4Node) == 16, "Bvh4Node layout");
 static_assert(sizeof(TrianglePacket) == 160 && alignof(TrianglePacket) == 16, "TrianglePacket layout");
+static_assert(sizeof(TriangleInfo) == 8 && alignof(TriangleInfo) == 4, "TriangleInfo layout");
 static_assert(sizeof(Triangle) == 48 && alignof(Triangle) == 16, "Triangle layout");
 static_assert(sizeof(Material) == 48 && alignof(Material) == 16, "Material layout");
 static_assert(sizeof(Light) == 64 && alignof(Light) == 16, "Light layout");

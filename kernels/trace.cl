@@ -12,7 +12,10 @@ kernel void trace_closest(global const Bvh4Node* nodes, global const TrianglePac
     if (g >= ray_count) return;
     Ray r = make_ray(origins[g].xyz, directions[g].xyz);
     Hit h = bvh_closest_hit(nodes, packets, &r, origins[g].w);
-    hits[g] = (float4)(h.t, h.b1, h.b2, as_float(h.triangle));
+    uint triangle = h.triangle == NO_HIT
+                        ? NO_HIT
+                        : packets[h.triangle / MCRT_PACKET_WIDTH].index[h.triangle % MCRT_PACKET_WIDTH];
+    hits[g] = (float4)(h.t, h.b1, h.b2, as_float(triangle));
 }
 
 /* Occlusion of ray g in (0, t_max): occluded[g] = 1 if anything blocks it, else 0. */

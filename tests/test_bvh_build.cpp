@@ -295,8 +295,8 @@ void validate4(const Bvh& bvh, const BvhBuildOptions& options) {
     CHECK(depth <= std::max(1, bvh.stats.depth - 1));
     CHECK(bvh.stats.sah_cost4 == Approx(cost).epsilon(1e-6));
     CHECK(bvh.stats.bytes == bvh.nodes4.size() * sizeof(gpu::Bvh4Node) +
-                                 bvh.packets.size() * sizeof(gpu::TrianglePacket) +
-                                 n * sizeof(gpu::Triangle));
+                                 bvh.packets.size() * (sizeof(gpu::TrianglePacket) +
+                                                       4 * sizeof(gpu::TriangleInfo)));
     if (n == 0) {
         for (int s = 0; s < 4; ++s) CHECK(is_empty_slot(bvh.nodes4[0], s));
         CHECK(bvh.stats.sah_cost4 == 0.0);

@@ -89,11 +89,11 @@ TEST_CASE("the device sees the shared structs with the host's sizes", "[cl]") {
                                         kernel_source("render.cl"), "-D ESTIMATOR_LIGHT_AREA");
     cl::Kernel kernel = make_kernel(program, "shared_type_sizes");
     cl_int status;
-    cl::Buffer sizes(device.context, CL_MEM_WRITE_ONLY, 8 * sizeof(cl_uint), nullptr, &status);
+    cl::Buffer sizes(device.context, CL_MEM_WRITE_ONLY, 9 * sizeof(cl_uint), nullptr, &status);
     REQUIRE(status == CL_SUCCESS);
     CL_CHECK(kernel.setArg(0, sizes));
     CL_CHECK(device.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(1)));
-    cl_uint got[8] = {};
+    cl_uint got[9] = {};
     CL_CHECK(device.queue.enqueueReadBuffer(sizes, CL_TRUE, 0, sizeof got, got));
     CHECK(got[0] == sizeof(gpu::BvhNode));
     CHECK(got[1] == sizeof(gpu::Triangle));
@@ -103,4 +103,5 @@ TEST_CASE("the device sees the shared structs with the host's sizes", "[cl]") {
     CHECK(got[5] == sizeof(gpu::AliasEntry));
     CHECK(got[6] == sizeof(gpu::Bvh4Node));
     CHECK(got[7] == sizeof(gpu::TrianglePacket));
+    CHECK(got[8] == sizeof(gpu::TriangleInfo));
 }

@@ -502,8 +502,8 @@ Bvh Builder::build() {
     bvh.stats.sah_cost4 = bvh4.sah_cost;
     bvh.stats.packets = bvh.packets.size();
     bvh.stats.bytes = bvh.nodes4.size() * sizeof(gpu::Bvh4Node) +
-                      bvh.packets.size() * sizeof(gpu::TrianglePacket) +
-                      bvh.triangles.size() * sizeof(gpu::Triangle);
+                      bvh.packets.size() * (sizeof(gpu::TrianglePacket) +
+                                            MCRT_PACKET_WIDTH * sizeof(gpu::TriangleInfo));
     const auto end = std::chrono::steady_clock::now();
     bvh.stats.collapse_seconds = std::chrono::duration<double>(end - collapse_start).count();
     bvh.stats.build_seconds = std::chrono::duration<double>(end - start).count();

@@ -33,7 +33,6 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
     GpuSceneData data;
     data.nodes = bvh.nodes4;
     data.packets = bvh.packets;
-    data.triangles = bvh.triangles;
     for (const Material& m : scene.materials) {
         gpu::Material g{};
         g.albedo = to_float4(m.albedo);
@@ -62,10 +61,18 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
     }
     data.light_cdf = build_cdf(powers);
     data.light_alias = build_alias_table(powers);
-    for (gpu::Triangle& t : data.triangles) {
-        uint32_t scene_triangle;
-        std::memcpy(&scene_triangle, &t.p1.w, sizeof scene_triangle);
-        t.p2.w = uint_bits(light_of_triangle[scene_triangle]);
+    // Shading's view of each packet lane (unused lanes stay zero: no ray hits them).
+    data.triangle_info.assign(bvh.packets.size() * MCRT_PACKET_WIDTH, gpu::TriangleInfo{});
+    for (size_t p = 0; p < bvh.packets.size(); ++p) {
+        for (int lane = 0; lane < MCRT_PACKET_WIDTH; ++lane) {
+            const uint32_t leaf = bvh.packets[p].index[lane];
+            if (leaf == 0xffffffffu) continue;
+            uint32_t scene_triangle;
+            std::memcpy(&scene_triangle, &bvh.triangles[leaf].p1.w, sizeof scene_triangle);
+            gpu::TriangleInfo& info = data.triangle_info[p * MCRT_PACKET_WIDTH + size_t(lane)];
+            info.material = scene.triangle_material[scene_triangle];
+            info.light = light_of_triangle[scene_triangle];
+        }
     }
     data.camera = make_gpu_camera(camera, width, height);
     return data;
@@ -92,7 +99,7 @@ static cl::Buffer upload(const DeviceContext& device, const std::vector<T>& item
 GpuSceneBuffers::GpuSceneBuffers(const DeviceContext& device, const GpuSceneData& data) {
     nodes = upload(device, data.nodes, bytes, "BVH nodes");
     packets = upload(device, data.packets, bytes, "triangle packets");
-    triangles = upload(device, data.triangles, bytes, "triangles");
+    triangle_info = upload(device, data.triangle_info, bytes, "triangle materials and lights");
     materials = upload(device, data.materials, bytes, "materials");
     lights = upload(device, data.lights, bytes, "lights");
     light_cdf = upload(device, data.light_cdf, bytes, "light CDF");

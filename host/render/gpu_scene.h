@@ -19,7 +19,7 @@ enum class LightSelect { Uniform, Power, Alias };
 struct GpuSceneData {
     std::vector<gpu::Bvh4Node> nodes;  // 4-wide, as the kernels traverse it
     std::vector<gpu::TrianglePacket> packets;  // the leaves' triangles, four per ray test
-    std::vector<gpu::Triangle> triangles;
+    std::vector<gpu::TriangleInfo> triangle_info;  // per packet lane: 4 per packet
     std::vector<gpu::Material> materials;
     std::vector<gpu::Light> lights;
     std::vector<float> light_cdf;  // lights + 1 entries, by power (PBRT 3rd ed. 13.3.1)
@@ -37,7 +37,7 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
 // Device copies of GpuSceneData (empty arrays get a one-element buffer, never a null one).
 struct GpuSceneBuffers {
     GpuSceneBuffers(const DeviceContext& device, const GpuSceneData& data);
-    cl::Buffer nodes, packets, triangles, materials, lights, light_cdf, light_alias, camera;
+    cl::Buffer nodes, packets, triangle_info, materials, lights, light_cdf, light_alias, camera;
     cl_uint light_count = 0;
     size_t bytes = 0;
 };

@@ -120,7 +120,7 @@ public:
         const cl_float4 sky = {{settings.sky.r, settings.sky.g, settings.sky.b, 0.0f}};
         CL_CHECK(render_.setArg(0, buffers_->nodes));
         CL_CHECK(render_.setArg(1, buffers_->packets));
-        CL_CHECK(render_.setArg(2, buffers_->triangles));
+        CL_CHECK(render_.setArg(2, buffers_->triangle_info));
         CL_CHECK(render_.setArg(3, buffers_->materials));
         CL_CHECK(render_.setArg(4, buffers_->lights));
         CL_CHECK(render_.setArg(5, buffers_->light_cdf));
