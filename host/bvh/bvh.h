@@ -34,7 +34,7 @@ struct BvhStats {
     size_t inner_nodes = 0, leaves = 0;
     size_t packets = 0;           // TrianglePackets (ceil(N / 4) per leaf of N triangles)
     size_t bytes = 0;  // what the device holds: 4-wide nodes, packets, a TriangleInfo per lane
-    double collapse_seconds = 0;  // of build_seconds, the BVH2 → BVH4 collapse
+    double collapse_seconds = 0;  // of build_seconds, the BVH2 → BVH4 collapse and packing
     int depth4 = 0;               // Bvh4Nodes on the longest root-to-leaf path, ≤ kMaxBvh4Depth
     double sah_cost4 = 0;         // SAH cost of the 4-wide tree (a node visit costs traversal_cost)
 };
