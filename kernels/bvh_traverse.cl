@@ -1,7 +1,8 @@
 /* BVH traversal over 4-wide nodes (Bvh4Node): closest hit for camera rays, any hit for shadow
- * rays. One slab test in float4 arithmetic covers a node's four children: PoCL runs each ray as
- * scalar code, so SIMD comes only from explicit vector types (shared/notes: BVH4 gave 1.5–1.9×
- * over the best BVH2 there). */
+ * rays. One slab test in float4 arithmetic covers a node's four children, one watertight test in
+ * float4 arithmetic a leaf's packet of four triangles: PoCL runs each ray as scalar code, so SIMD
+ * comes only from explicit vector types (docs/BENCHMARKS.md, issue 6: the node gave up to 1.5×
+ * over a BVH2, the packets 1.3–1.4× more on the large scenes). */
 #ifndef MCRT_BVH_TRAVERSE_CL
 #define MCRT_BVH_TRAVERSE_CL
 

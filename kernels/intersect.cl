@@ -14,45 +14,6 @@
 #define MCRT_HAVE_FP64 1
 #endif
 
-/* On a hit with t in (0, t_max): returns true and sets *t and the barycentrics b1, b2 of p1, p2. */
-inline bool intersect_triangle(const Ray* r, float4 p0, float4 p1, float4 p2, float t_max,
-                               float* t_hit, float* b1, float* b2) {
-    /* Translate to the ray origin, permute so that z is the dominant axis, shear (sec. 3). */
-    float4 a = shuffle(p0 - (float4)(r->org, 0.0f), r->shear_axes);
-    float4 b = shuffle(p1 - (float4)(r->org, 0.0f), r->shear_axes);
-    float4 c = shuffle(p2 - (float4)(r->org, 0.0f), r->shear_axes);
-    float ax = a.x - r->shear.x * a.z, ay = a.y - r->shear.y * a.z;
-    float bx = b.x - r->shear.x * b.z, by = b.y - r->shear.y * b.z;
-    float cx = c.x - r->shear.x * c.z, cy = c.y - r->shear.y * c.z;
-
-    /* Scaled barycentrics as 2D edge functions. */
-    float u = cx * by - cy * bx;
-    float v = ax * cy - ay * cx;
-    float w = bx * ay - by * ax;
-#ifdef MCRT_HAVE_FP64
-    /* An exact zero may be a rounding artefact on a shared edge: recompute in double. */
-    if (u == 0.0f || v == 0.0f || w == 0.0f) {
-        u = (float)((double)cx * (double)by - (double)cy * (double)bx);
-        v = (float)((double)ax * (double)cy - (double)ay * (double)cx);
-        w = (float)((double)bx * (double)ay - (double)by * (double)ax);
-    }
-#endif
-    if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
-    float det = u + v + w;
-    if (det == 0.0f) return false;
-
-    /* Scaled hit distance; compare before dividing. */
-    float az = r->shear.z * a.z, bz = r->shear.z * b.z, cz = r->shear.z * c.z;
-    float t_scaled = u * az + v * bz + w * cz;
-    float inv_det = 1.0f / det;
-    float t = t_scaled * inv_det;
-    if (!(t > 0.0f && t < t_max)) return false;
-    *t_hit = t;
-    *b1 = v * inv_det;
-    *b2 = w * inv_det;
-    return true;
-}
-
 /* The ray as the four-lane test reads it: its origin on the permuted axes kx, ky, kz and its
  * shear, splatted, and the permutation as indices into TrianglePacket.v. */
 typedef struct {
@@ -76,9 +37,13 @@ inline PacketRay make_packet_ray(const Ray* r) {
     return q;
 }
 
-/* intersect_triangle on the four lanes of a packet at once: the same operations in the same
- * order, lane by lane, so each lane's answer is bit for bit the scalar one (and as watertight).
- * Returns a lane mask (-1 where a used lane is hit with t in (0, t_max)) and its t, b1, b2. */
+/* The watertight test on the four triangles of a packet at once, each lane doing exactly the
+ * operations of the scalar test of Woop et al. in the same order (so a lane's answer does not
+ * depend on its packet): translate to the ray origin, permute so that z is the dominant axis,
+ * shear (sec. 3); scaled barycentrics as 2D edge functions, recomputed in double when one is an
+ * exact zero, which may be a rounding artefact on a shared edge; the scaled hit distance compared
+ * before dividing. Returns a lane mask (-1 where a used lane is hit with t in (0, t_max)) and the
+ * lanes' t and barycentrics b1, b2 of vertices 1 and 2. */
 inline int4 intersect_packet(const PacketRay* q, global const TrianglePacket* pk, float t_max,
                              float4* t_hit, float4* b1, float4* b2) {
     global const float4* v = pk->v;
