@@ -771,15 +771,31 @@ TEST_CASE("build_cdf and build_alias_table", "[sampling][discrete]") {
     CHECK_THROWS_AS(build_alias_table({1.0, NAN}), InputError);
     CHECK(build_cdf({3.0}) == std::vector<float>{0.0f, 1.0f});
 
-    for (const std::vector<double>& w : weight_vectors()) {
+    // Weights 20 orders of magnitude apart: the light of 1e-20 of the power still gets one step
+    // of the kernels' 2^-24 grid (a float CDF of w/Σw would give it an empty interval).
+    std::vector<float> tiny = build_cdf({1e-12, 1.0, 1e-9, 0.0, 1e-20});
+    REQUIRE(tiny.size() == 6);
+    CHECK(tiny[1] - tiny[0] == 0x1.0p-24f);
+    CHECK(tiny[3] - tiny[2] == 0x1.0p-24f);
+    CHECK(tiny[4] == tiny[3]);
+    CHECK(tiny[5] - tiny[4] == 0x1.0p-24f);
+    CHECK(tiny[5] == 1.0f);
+
+    std::vector<std::vector<double>> vectors = weight_vectors();
+    vectors.push_back(std::vector<double>(3000, 1.0));  // 2^24 / 3000 is not whole: remainders
+    vectors.back()[7] = 1e-15;
+    for (const std::vector<double>& w : vectors) {
         double total = std::accumulate(w.begin(), w.end(), 0.0);
         std::vector<float> cdf = build_cdf(w);
         REQUIRE(cdf.size() == w.size() + 1);
         CHECK(cdf.front() == 0.0f);
         CHECK(cdf.back() == 1.0f);
         for (size_t i = 0; i < w.size(); ++i) {
-            CHECK(cdf[i] <= cdf[i + 1]);
+            // On the grid of u (kernels/rng.cl), so the interval's width is exactly the
+            // probability that u falls in it; positive weights are never left out.
+            CHECK(double(cdf[i + 1]) * 0x1.0p24 == std::floor(double(cdf[i + 1]) * 0x1.0p24));
             if (w[i] == 0) CHECK(cdf[i] == cdf[i + 1]);
+            if (w[i] > 0) CHECK(cdf[i] < cdf[i + 1]);
             CHECK(std::abs((cdf[i + 1] - cdf[i]) - w[i] / total) <= 0x1.0p-23);
         }
         // Implied probability of i: its own share of its bucket plus the rest of the buckets

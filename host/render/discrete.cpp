@@ -1,6 +1,8 @@
 #include "render/discrete.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 #include "common/error.h"
@@ -28,15 +30,53 @@ double checked_total(const std::vector<double>& weights) {
 std::vector<float> build_cdf(const std::vector<double>& weights) {
     double total = checked_total(weights);
     if (total == 0.0) return {0.0f};
-    size_t n = weights.size(), last = 0;  // last positive weight
-    for (size_t i = 0; i < n; ++i)
-        if (weights[i] > 0.0) last = i;
-    std::vector<float> cdf(n + 1, 1.0f);  // entries from last + 1 on are exactly 1
+    const size_t n = weights.size();
+    // The kernels' u is a multiple of 2^-24 (kernels/rng.cl), so the CDF is built on that grid:
+    // entry i gets units[i] steps of 2^-24, every positive weight at least one, so that every
+    // light with power is reachable and its pmf, cdf[i+1] − cdf[i] = units[i]·2^-24, is exact
+    // in float and is the probability of selecting it (PBRT 3rd ed. 13.3.1 with its rounding
+    // made exact). Largest remainders settle the total at 2^24 (Hamilton's apportionment).
+    constexpr int64_t kGrid = int64_t(1) << 24;
+    size_t positive = 0;
+    for (double w : weights) positive += w > 0.0;
+    std::vector<int64_t> units(n, 0);
+    std::vector<double> ideal(n, 0.0);
+    int64_t assigned = 0;
+    const bool room = positive <= size_t(kGrid);  // else the smallest lights cannot all fit
+    for (size_t i = 0; i < n; ++i) {
+        if (weights[i] <= 0.0) continue;
+        ideal[i] = double(kGrid) * (weights[i] / total);
+        units[i] = int64_t(std::floor(ideal[i]));
+        if (room && units[i] == 0) units[i] = 1;
+        assigned += units[i];
+    }
+    if (assigned != kGrid) {
+        // Entries ordered by what they still miss (ideal − units): give to the front, take from
+        // the back (never below one unit when there is room, never from a zero weight).
+        std::vector<size_t> order;
+        for (size_t i = 0; i < n; ++i)
+            if (weights[i] > 0.0) order.push_back(i);
+        std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+            return ideal[a] - double(units[a]) > ideal[b] - double(units[b]);
+        });
+        const int64_t floor_units = room ? 1 : 0;
+        while (assigned < kGrid)
+            for (size_t k = 0; k < order.size() && assigned < kGrid; ++k) ++units[order[k]], ++assigned;
+        while (assigned > kGrid) {
+            bool took = false;
+            for (size_t k = order.size(); k-- > 0 && assigned > kGrid;) {
+                if (units[order[k]] <= floor_units) continue;
+                --units[order[k]], --assigned, took = true;
+            }
+            if (!took) throw RuntimeError("discrete distribution: cannot apportion the CDF");
+        }
+    }
+    std::vector<float> cdf(n + 1);
     cdf[0] = 0.0f;
-    double running = 0.0;
-    for (size_t i = 0; i < last; ++i) {
-        running += weights[i];
-        cdf[i + 1] = std::fmin(float(running / total), 1.0f);
+    int64_t running = 0;
+    for (size_t i = 0; i < n; ++i) {
+        running += units[i];
+        cdf[i + 1] = float(running) * 0x1.0p-24f;  // exact: running ≤ 2^24
     }
     return cdf;
 }

@@ -8,11 +8,14 @@
 
 namespace mcrt {
 
-// CDF of weights / Σweights as n + 1 floats: cdf[0] = 0, cdf[n] = 1 exactly, accumulated in
-// double. A zero weight gives an empty interval (cdf[i+1] == cdf[i]), never sampled; so does a
-// positive weight below float resolution of its cdf entries (pmf < ~6e-8). Empty or all-zero
-// weights give {0}: a distribution of no entries, which callers must not sample. Throws
-// InputError on a negative or non-finite weight, or a non-finite sum.
+// CDF of weights / Σweights as n + 1 floats on the 2^-24 grid of the kernels' random numbers:
+// cdf[0] = 0, cdf[n] = 1, each interval a whole number of 2^-24 steps within two steps of its
+// share, so that the pmf the kernels read (cdf[i+1] − cdf[i]) is exactly the probability that
+// a grid-uniform u selects i. A zero weight gives an empty interval, never sampled; every
+// positive weight gets at least one step, however small (up to 2^24 positive weights; beyond
+// that the smallest may get none). Empty or all-zero weights give {0}: a distribution of no
+// entries, which callers must not sample. Throws InputError on a negative or non-finite
+// weight, or a non-finite sum.
 std::vector<float> build_cdf(const std::vector<double>& weights);
 
 // Alias table of weights / Σweights (Vose 1991, "A linear algorithm for generating random
