@@ -54,8 +54,8 @@ inline float2 invert_triangle_uniform(float2 b) {
 inline float3 sample_hemisphere_uniform(float2 u) {
     float z = 1.0f - u.x;
     float r = sqrt(max(0.0f, u.x * (2.0f - u.x))); /* √(1 − z²) without cancellation */
-    float phi = 2.0f * M_PI_F * u.y;
-    return (float3)(r * cos(phi), r * sin(phi), z);
+    float turns = 2.0f * u.y; /* φ/π, exact */
+    return (float3)(r * cospi(turns), r * sinpi(turns), z);
 }
 
 /* Density of sample_hemisphere_uniform with respect to solid angle: 1/(2π) above the horizon. */
@@ -70,15 +70,15 @@ inline float2 invert_hemisphere_uniform(float3 w) {
 inline float2 sample_disk_concentric(float2 u) {
     float a = 2.0f * u.x - 1.0f, b = 2.0f * u.y - 1.0f;
     if (a == 0.0f && b == 0.0f) return (float2)(0.0f, 0.0f);
-    float r, phi;
+    float r, turns; /* φ/π */
     if (fabs(a) > fabs(b)) {
         r = a;
-        phi = (0.25f * M_PI_F) * (b / a);
+        turns = 0.25f * (b / a);
     } else {
         r = b;
-        phi = 0.5f * M_PI_F - (0.25f * M_PI_F) * (a / b);
+        turns = 0.5f - 0.25f * (a / b);
     }
-    return (float2)(r * cos(phi), r * sin(phi));
+    return (float2)(r * cospi(turns), r * sinpi(turns));
 }
 
 /* Inverse of sample_disk_concentric: the square's sector from the polar angle. */
@@ -208,12 +208,12 @@ inline float2 invert_spherical_triangle(float3 a, float3 b, float3 c, float3 w) 
 inline float3 sample_hemisphere_fibonacci(uint i, uint n, float2 u) {
     uint golden = i * 0x9E3779B9u + mul_hi(i, 0x7F4A7C15u);
     uint offset = (uint)(min(u.y, ONE_MINUS_EPSILON_F) * 4294967296.0f);
-    float phi = 2.0f * M_PI_F * ((float)((golden + offset) >> 8) * 0x1.0p-24f);
+    float turns = 2.0f * ((float)((golden + offset) >> 8) * 0x1.0p-24f); /* φ/π */
     float inv_n = 1.0f / (float)n;
     float one_minus_z = ((float)i + u.x) * inv_n; /* accurate near the pole */
     float z = ((float)(n - i) - u.x) * inv_n;     /* accurate near the horizon, > 0 */
     float r = sqrt(max(0.0f, one_minus_z * (1.0f + z)));
-    return (float3)(r * cos(phi), r * sin(phi), z);
+    return (float3)(r * cospi(turns), r * sinpi(turns), z);
 }
 
 /* Density of sample_hemisphere_fibonacci with respect to solid angle, marginally over the point
