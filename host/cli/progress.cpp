@@ -1,5 +1,6 @@
 #include "cli/progress.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 
@@ -9,6 +10,17 @@ ProgressBar::ProgressBar(bool enabled, uint64_t samples_per_spp)
     : enabled_(enabled), samples_per_spp_(samples_per_spp),
       start_(std::chrono::steady_clock::now()), last_(start_) {}
 
+double progress_fraction(uint32_t done, uint32_t total, uint64_t samples_per_spp,
+                         const std::vector<DeviceReport>& devices) {
+    if (total == 0) return 1.0;
+    const double committed = double(done) / total;
+    uint64_t finished = 0;
+    for (const DeviceReport& d : devices) finished += d.samples;
+    const double all = double(samples_per_spp) * total;
+    const double launched = all > 0 ? double(finished) / all : 0.0;
+    return std::min(1.0, std::max(committed, launched));
+}
+
 void ProgressBar::update(uint32_t done, uint32_t total, const std::vector<DeviceReport>& devices) {
     if (!enabled_ || total == 0) return;
     auto now = std::chrono::steady_clock::now();
@@ -16,8 +28,8 @@ void ProgressBar::update(uint32_t done, uint32_t total, const std::vector<Device
     last_ = now;
     drawn_ = true;
     double elapsed = std::chrono::duration<double>(now - start_).count();
-    double fraction = double(done) / total;
-    double rate = elapsed > 0 ? double(done) * samples_per_spp_ / elapsed : 0.0;
+    double fraction = progress_fraction(done, total, samples_per_spp_, devices);
+    double rate = elapsed > 0 ? fraction * double(total) * samples_per_spp_ / elapsed : 0.0;
     double left = fraction > 0 ? elapsed * (1 - fraction) / fraction : 0.0;
     const int width = 30;
     int filled = int(fraction * width + 0.5);

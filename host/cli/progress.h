@@ -9,6 +9,12 @@
 
 namespace mcrt {
 
+// Fraction of the render done: the samples the devices have finished (Σ DeviceReport::samples,
+// which moves with every launch) over pixels · total spp, never below what the image holds
+// (done of total spp: whole chunk rows of 16 spp) and never above 1.
+double progress_fraction(uint32_t done, uint32_t total, uint64_t samples_per_spp,
+                         const std::vector<DeviceReport>& devices);
+
 class ProgressBar {
 public:
     ProgressBar(bool enabled, uint64_t samples_per_spp);

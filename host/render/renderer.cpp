@@ -188,11 +188,18 @@ public:
         double busy = event_seconds(render_done) + event_seconds(reduce_done);
         if (slow_factor_ > 1.0)  // simulate a slower device (MCRT_SLOW_DEVICE)
             std::this_thread::sleep_for(std::chrono::duration<double>(busy * (slow_factor_ - 1.0)));
-        report.seconds_busy += busy;
-        report.samples += samples;
-        report.batches += 1;
+        // Counted into the report by commit_report(), under the lock the progress reads it with.
+        pending_busy_ = busy;
+        pending_samples_ = samples;
         (void)queue;
         return result;
+    }
+
+    // Adds the last successful launch to the report; the caller holds the render's lock.
+    void commit_report() {
+        report.seconds_busy += pending_busy_;
+        report.samples += pending_samples_;
+        report.batches += 1;
     }
 
     DeviceReport report;
@@ -204,6 +211,8 @@ private:
     uint64_t max_samples_ = 0;
     uint64_t launches_ = 0, fail_at_launch_ = 0;
     double slow_factor_ = 1.0;
+    double pending_busy_ = 0;
+    uint64_t pending_samples_ = 0;
     cl::Kernel render_, reduce_;
     std::unique_ptr<GpuSceneBuffers> buffers_;
     cl::Buffer samples_, sums_, sums_sq_;
@@ -262,6 +271,7 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
                 return;
             }
             std::lock_guard<std::mutex> lock(acc_mutex);
+            worker.commit_report();
             acc.submit(std::move(r));
             queue.done(*item);
         }
