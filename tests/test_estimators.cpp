@@ -9,56 +9,13 @@
 #include "analytic_scenes.h"
 #include "bvh/bvh.h"
 #include "device_support.h"
+#include "independent_renders.h"
 #include "render/renderer.h"
 
 using namespace mcrt;
 using namespace mcrt::test;
 
 namespace {
-
-const char* sampler_name(SamplerKind s) {
-    return s == SamplerKind::Independent ? "independent"
-           : s == SamplerKind::Stratified ? "stratified"
-                                          : "sobol";
-}
-
-const char* select_name(LightSelect s) {
-    return s == LightSelect::Uniform ? "uniform" : s == LightSelect::Power ? "power" : "alias";
-}
-
-struct Renders {
-    std::vector<glm::dvec3> means;  // image mean of each independent render
-    glm::dvec3 mean{0.0}, standard_error{0.0};
-    double mean_layer_variance = 0;  // mean over renders of the variance layer's image mean
-    uint64_t nan_samples = 0;
-};
-
-// `count` renders with seeds 1000, 1001, ...: the mean of their image means and its standard
-// error from their spread.
-Renders independent_renders(const DeviceContext& device, const GpuSceneData& data,
-                            RenderSettings settings, int count) {
-    Renders r;
-    for (int k = 0; k < count; ++k) {
-        settings.seed = 1000u + uint32_t(k);
-        RenderResult result = render(device, data, settings);
-        glm::dvec3 m(0.0);
-        double layer = 0;
-        size_t n = size_t(settings.width) * settings.height;
-        for (size_t p = 0; p < n; ++p)
-            for (int c = 0; c < 3; ++c) {
-                m[c] += result.image.rgb[3 * p + c] / double(n);
-                layer += result.image.variance[3 * p + c] / double(3 * n * n);
-            }
-        r.means.push_back(m);
-        r.mean += m / double(count);
-        r.mean_layer_variance += layer / count;
-        r.nan_samples += result.nan_samples;
-    }
-    glm::dvec3 var(0.0);
-    for (const glm::dvec3& m : r.means) var += (m - r.mean) * (m - r.mean) / double(count - 1);
-    r.standard_error = glm::sqrt(var / double(count));
-    return r;
-}
 
 // |mean − exact| within 4.5 standard errors in every channel. With 10 renders the standard
 // error is itself uncertain (χ² with 9 degrees of freedom); 4.5 leaves room for that.
@@ -72,6 +29,7 @@ void check_unbiased(const Renders& r, glm::dvec3 exact, const std::string& what)
 }
 
 constexpr int kRenders = 10;
+constexpr uint32_t kFirstSeed = 1000;  // renders use seeds 1000, 1001, ...
 
 }  // namespace
 
@@ -83,8 +41,7 @@ TEST_CASE("direct-light estimators are unbiased on a polygon light over a plane"
     settings.width = 16;
     settings.height = 16;
     settings.spp = 64;
-    Bvh bvh = build_bvh(ps.scene);
-    GpuSceneData data = make_gpu_scene(ps.scene, bvh, ps.camera, settings.width, settings.height);
+    GpuSceneData data = gpu_scene_for(ps.scene, ps.camera, settings);
     glm::dvec3 exact = image_mean(ps.exact_image(settings.width, settings.height));
 
     struct Variant {
@@ -109,7 +66,7 @@ TEST_CASE("direct-light estimators are unbiased on a polygon light over a plane"
                 settings.sampler = sampler;
                 // Hemisphere sampling rarely finds these small lights: give it more samples.
                 settings.spp = v.uses_lights ? 64 : 1024;
-                Renders r = independent_renders(device, data, settings, kRenders);
+                Renders r = independent_renders(device, data, settings, kRenders, kFirstSeed);
                 std::string what = std::string(v.estimator) +
                                    (v.heuristic == MisHeuristic::Power ? " (power)" : "") + " / " +
                                    select_name(select) + " / " + sampler_name(sampler);
@@ -134,13 +91,12 @@ TEST_CASE("in a furnace every estimator is unbiased and the cosine estimator has
     settings.width = 8;
     settings.height = 8;
     settings.spp = 32;
-    Bvh bvh = build_bvh(scene);
-    GpuSceneData data = make_gpu_scene(scene, bvh, camera, settings.width, settings.height);
+    GpuSceneData data = gpu_scene_for(scene, camera, settings);
     glm::dvec3 exact = glm::dvec3(Le) * (1.0 + glm::dvec3(albedo));
     for (const char* estimator :
          {"light-area", "light-solid-angle", "mis", "hemisphere-uniform", "hemisphere-cosine"}) {
         settings.estimator = estimator;
-        Renders r = independent_renders(device, data, settings, kRenders);
+        Renders r = independent_renders(device, data, settings, kRenders, kFirstSeed);
         if (std::string(estimator) == "hemisphere-cosine") {
             // f·Le·cosθ / (cosθ/π) = ρ·Le for every sample: only rounding is left.
             INFO("cosine: mean " << r.mean.x << ", layer variance " << r.mean_layer_variance);
@@ -175,8 +131,7 @@ TEST_CASE("ambient estimators are unbiased next to a wall (its projected solid a
     settings.height = 16;
     settings.spp = 64;
     settings.sky = glm::vec3(sky);
-    Bvh bvh = build_bvh(scene);
-    GpuSceneData data = make_gpu_scene(scene, bvh, camera, settings.width, settings.height);
+    GpuSceneData data = gpu_scene_for(scene, camera, settings);
     glm::dvec3 exact = image_mean(exact_plane_image(camera, 16, 16, [&](glm::dvec3 p) {
         double form_factor = lambert_irradiance(wall_polygon, p, {0, 1, 0}, 1.0) / M_PI;
         return albedo * sky * (1.0 - form_factor);
@@ -186,7 +141,7 @@ TEST_CASE("ambient estimators are unbiased next to a wall (its projected solid a
              {SamplerKind::Independent, SamplerKind::Stratified, SamplerKind::Sobol}) {
             settings.estimator = estimator;
             settings.sampler = sampler;
-            Renders r = independent_renders(device, data, settings, kRenders);
+            Renders r = independent_renders(device, data, settings, kRenders, kFirstSeed);
             check_unbiased(r, exact, std::string(estimator) + " / " + sampler_name(sampler));
             CHECK(r.standard_error.x < 0.02 * exact.x);
         }
@@ -205,8 +160,7 @@ TEST_CASE("ambient occlusion distance: a far wall stops occluding", "[estimators
     settings.spp = 64;
     settings.estimator = "ambient-cosine";
     settings.ao_distance = 0.1f;  // the wall is 0.6 or more away: nothing occludes
-    Bvh bvh = build_bvh(scene);
-    GpuSceneData data = make_gpu_scene(scene, bvh, camera, settings.width, settings.height);
+    GpuSceneData data = gpu_scene_for(scene, camera, settings);
     RenderResult r = render(device, data, settings);
     for (float v : r.image.rgb) CHECK(v == Approx(1.0f).epsilon(1e-6));
 }
@@ -219,12 +173,11 @@ TEST_CASE("power and alias selection have lower variance than uniform with unequ
     settings.width = 16;
     settings.height = 16;
     settings.spp = 64;
-    Bvh bvh = build_bvh(ps.scene);
-    GpuSceneData data = make_gpu_scene(ps.scene, bvh, ps.camera, settings.width, settings.height);
+    GpuSceneData data = gpu_scene_for(ps.scene, ps.camera, settings);
     double layer[3];
     for (LightSelect select : {LightSelect::Uniform, LightSelect::Power, LightSelect::Alias}) {
         settings.light_select = select;
-        layer[int(select)] = independent_renders(device, data, settings, 4).mean_layer_variance;
+        layer[int(select)] = independent_renders(device, data, settings, 4, kFirstSeed).mean_layer_variance;
     }
     INFO("variance: uniform " << layer[0] << ", power " << layer[1] << ", alias " << layer[2]);
     CHECK(layer[1] < layer[0]);
@@ -241,10 +194,9 @@ TEST_CASE("with the independent sampler the variance layer predicts the spread o
     settings.width = 16;
     settings.height = 16;
     settings.spp = 32;
-    Bvh bvh = build_bvh(ps.scene);
-    GpuSceneData data = make_gpu_scene(ps.scene, bvh, ps.camera, settings.width, settings.height);
+    GpuSceneData data = gpu_scene_for(ps.scene, ps.camera, settings);
     const int renders = 40;
-    Renders r = independent_renders(device, data, settings, renders);
+    Renders r = independent_renders(device, data, settings, renders, kFirstSeed);
     // Variance of the image mean predicted by the layer, against the spread of 40 renders; the
     // spread's own relative uncertainty is √(2/39) ≈ 23%, so 35% is about 1.5 of its σ.
     double predicted = r.mean_layer_variance;

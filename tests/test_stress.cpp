@@ -20,6 +20,7 @@
 #include "analytic_scenes.h"
 #include "bvh/bvh.h"
 #include "device_support.h"
+#include "independent_renders.h"
 #include "image/image.h"
 #include "process_support.h"
 #include "render/renderer.h"
@@ -171,49 +172,9 @@ const Variant kVariants[] = {{"light-area", MisHeuristic::Balance, true, true},
                              {"ambient-cosine", MisHeuristic::Balance, false, false},
                              {"ambient-fibonacci", MisHeuristic::Balance, false, false}};
 
-const char* select_name(LightSelect s) {
-    return s == LightSelect::Uniform ? "uniform" : s == LightSelect::Power ? "power" : "alias";
-}
-
 std::string variant_name(const Variant& v, LightSelect s) {
     return std::string(v.estimator) + (v.heuristic == MisHeuristic::Power ? " (power)" : "") +
            (v.uses_lights ? std::string(" / ") + select_name(s) : "");
-}
-
-struct Renders {
-    glm::dvec3 mean{0.0}, standard_error{0.0};
-    uint64_t nan_samples = 0;
-    size_t non_finite_pixels = 0;  // pixels with a NaN or Inf in rgb or variance
-};
-
-// `count` renders with seeds 2000, 2001, ...: mean of their image means, and its standard error
-// from their spread.
-Renders independent_renders(const DeviceContext& device, const GpuSceneData& data,
-                            RenderSettings settings, int count) {
-    Renders r;
-    std::vector<glm::dvec3> means;
-    const size_t n = size_t(settings.width) * settings.height;
-    for (int k = 0; k < count; ++k) {
-        settings.seed = 2000u + uint32_t(k);
-        RenderResult result = render(device, data, settings);
-        r.nan_samples += result.nan_samples;
-        glm::dvec3 m(0.0);
-        for (size_t p = 0; p < n; ++p) {
-            bool finite = true;
-            for (int c = 0; c < 3; ++c) {
-                finite = finite && std::isfinite(result.image.rgb[3 * p + c]) &&
-                         std::isfinite(result.image.variance[3 * p + c]);
-                m[c] += result.image.rgb[3 * p + c] / double(n);
-            }
-            r.non_finite_pixels += finite ? 0 : 1;
-        }
-        means.push_back(m);
-        r.mean += m / double(count);
-    }
-    glm::dvec3 var(0.0);
-    for (const glm::dvec3& m : means) var += (m - r.mean) * (m - r.mean) / double(count - 1);
-    r.standard_error = glm::sqrt(var / double(count));
-    return r;
 }
 
 std::string format(glm::dvec3 v) {
@@ -223,6 +184,7 @@ std::string format(glm::dvec3 v) {
 }
 
 constexpr int kRenders = 16;
+constexpr uint32_t kFirstSeed = 2000;  // renders use seeds 2000, 2001, ...
 
 // The scene × estimator pairs that are the estimator's failure case at test sizes: too few
 // hits (a light of 1e-4 sr, or one within 1° of the horizon for cosine sampling) for a standard
@@ -285,7 +247,7 @@ TEST_CASE(
                 // Direction sampling finds small lights rarely: more samples (as test_estimators).
                 bool directions = std::string(v.estimator).rfind("hemisphere", 0) == 0;
                 settings.spp = directions ? 256 : 32;
-                Renders r = independent_renders(device, data, settings, kRenders);
+                Renders r = independent_renders(device, data, settings, kRenders, kFirstSeed);
                 std::string what = name + ": " + variant_name(v, select);
                 INFO(what << ": mean " << format(r.mean) << ", exact " << format(exact)
                           << ", standard error " << format(r.standard_error));
