@@ -1,5 +1,5 @@
 // libFuzzer target: the bytes of a .gltf or .glb file through mcrt's glTF import, as
-// `mcrt render` loads a scene. Refusing a file (InputError) is the expected outcome for most
+// `mcrt render` loads a scene, then through the host's BVH build and light distributions. Refusing a file (InputError) is the expected outcome for most
 // inputs; anything else escaping is a crash, and so is an imported scene that breaks the
 // contract the renderer relies on (finite positions, in-range materials, finite emission,
 // rigid cameras with yfov in (0, pi)), which the checks below turn into an abort.
@@ -9,7 +9,9 @@
 #include <cstdlib>
 #include <vector>
 
+#include "bvh/bvh.h"
 #include "common/error.h"
+#include "render/discrete.h"
 #include "scene/gltf_import.h"
 #include "scene/scene.h"
 
@@ -53,6 +55,37 @@ void check_scene(const mcrt::Scene& scene) {
         require(finite(glm::vec3(bench.camera_to_world[i])), "finite bench camera");
 }
 
+// What the renderer builds from the scene on the host: the BVH with its packets (every triangle
+// in exactly one packet lane) and the light CDF (on the 2^-24 grid, every positive power
+// reachable) and alias table.
+void check_host_structures(const mcrt::Scene& scene) {
+    const mcrt::Bvh bvh = mcrt::build_bvh(scene);
+    std::vector<int> seen(scene.triangle_count(), 0);
+    for (const mcrt::gpu::TrianglePacket& p : bvh.packets)
+        for (uint32_t leaf : p.index) {
+            if (leaf == 0xffffffffu) continue;
+            require(leaf < bvh.triangles.size(), "packet lane in range");
+            if (leaf < seen.size()) ++seen[leaf];
+        }
+    for (int n : seen) require(n == 1, "every triangle in one packet lane");
+    require(bvh.stats.depth4 <= mcrt::kMaxBvh4Depth, "BVH4 depth within the stack bound");
+
+    std::vector<double> powers;
+    for (const mcrt::EmissiveTriangle& e : mcrt::collect_emitters(scene)) powers.push_back(e.power);
+    const std::vector<float> cdf = mcrt::build_cdf(powers);
+    require(cdf.size() == (powers.empty() ? 1 : powers.size() + 1), "CDF size");
+    double total = 0;
+    for (double p : powers) total += p;
+    if (total > 0) {
+        require(cdf.back() == 1.0f, "CDF ends at 1");
+        for (size_t i = 0; i < powers.size(); ++i)
+            require(powers[i] > 0 ? cdf[i + 1] > cdf[i] : cdf[i + 1] == cdf[i],
+                    "a CDF step for each light with power, none for the others");
+    }
+    require(mcrt::build_alias_table(powers).size() == (total > 0 ? powers.size() : 0),
+            "alias table size");
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -62,6 +95,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         const mcrt::Scene scene =
             mcrt::load_gltf_from_memory("fuzz-input", bytes, [](const std::string&) {});
         check_scene(scene);
+        check_host_structures(scene);
     } catch (const mcrt::InputError&) {
         // Refused with a message: what a broken file should get.
     }
