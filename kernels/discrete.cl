@@ -31,17 +31,19 @@ inline DiscreteSample sample_discrete_cdf(global const float* cdf, uint n, float
 /* Probability that sample_discrete_cdf returns i < n. */
 inline float discrete_cdf_pmf(global const float* cdf, uint i) { return cdf[i + 1u] - cdf[i]; }
 
-/* Alias method (Walker 1977; Vose 1991) with one number: u·n picks the bucket and its fraction
- * is the coin, so with a 24-bit u the coin has 24 − log2(n) bits (fine for n up to ~2^12).
- * n > 0 and u in [0, 1). Entries with prob 0 (zero weight) are only reached through an alias,
- * which never points to them. */
+/* Alias method (Walker 1977; Vose 1991) with one number on the 2^-24 grid: k = u·2^24 and
+ * k·n (exact in 64 bits) give the bucket, k·n / 2^24, and the coin, k·n mod 2^24, both integers,
+ * so the probability of each outcome is a count of k values that the host's build_alias_table
+ * makes the reported pmf. n > 0 and u in [0, 1). Entries of zero pmf (zero weight) have
+ * threshold 0 and are never an alias. */
 inline DiscreteSample sample_discrete_alias(global const AliasEntry* table, uint n, float u) {
-    float scaled = u * (float)n;
-    uint bucket = min((uint)scaled, n - 1u);
-    float coin = scaled - (float)bucket;
+    uint k = min((uint)(u * 16777216.0f), 16777215u);
+    ulong t = (ulong)k * (ulong)n;
+    uint bucket = (uint)(t >> 24);
+    uint coin = (uint)(t & 0xfffffful);
     AliasEntry e = table[bucket];
     DiscreteSample s;
-    s.index = coin < e.prob ? bucket : e.alias;
+    s.index = coin < e.threshold ? bucket : e.alias;
     s.pmf = table[s.index].pmf;
     return s;
 }

@@ -100,10 +100,12 @@ typedef struct {
     float4 Le;  /* .xyz emitted radiance, .w unused (selection pmfs live in the light CDF) */
 } Light;
 
-/* One entry of an alias table (Walker 1977; Vose 1991), 16 bytes: bucket i keeps i with
- * probability prob, else gives alias; pmf is the probability of i itself. */
+/* One entry of an alias table (Walker 1977; Vose 1991), 16 bytes, on the 2^-24 grid of the
+ * kernels' u (kernels/discrete.cl): bucket i keeps i when its coin, an integer in [0, 2^24), is
+ * below threshold, else gives alias; pmf is the probability of i itself, exactly (a whole
+ * number of 2^-24 steps, as the host counts them). */
 typedef struct {
-    float prob;
+    uint threshold;
     uint alias;
     float pmf;
     uint pad0;

@@ -798,25 +798,33 @@ TEST_CASE("build_cdf and build_alias_table", "[sampling][discrete]") {
             if (w[i] > 0) CHECK(cdf[i] < cdf[i + 1]);
             CHECK(std::abs((cdf[i + 1] - cdf[i]) - w[i] / total) <= 0x1.0p-23);
         }
-        // Implied probability of i: its own share of its bucket plus the rest of the buckets
-        // aliased to it, over n.
+        // Every k of the kernels' 2^24 grid through sample_discrete_alias's integer mapping
+        // (kernels/discrete.cl): the count of k giving i is the table's pmf · 2^24, exactly.
         std::vector<gpu::AliasEntry> table = build_alias_table(w);
         REQUIRE(table.size() == w.size());
-        std::vector<double> implied(w.size(), 0.0);
-        for (size_t i = 0; i < w.size(); ++i) {
-            CHECK(table[i].prob >= 0.0f);
-            CHECK(table[i].prob <= 1.0f);
-            REQUIRE(table[i].alias < w.size());
-            implied[i] += table[i].prob;
-            implied[table[i].alias] += 1.0 - table[i].prob;
-            if (w[i] == 0) CHECK(table[i].prob == 0.0f);
-            CHECK(table[i].pmf == Approx(w[i] / total).epsilon(1e-6));
+        const uint64_t n = w.size();
+        std::vector<uint64_t> hits(n, 0);
+        for (uint64_t k = 0; k < (uint64_t(1) << 24); ++k) {
+            const uint64_t t = k * n, bucket = t >> 24, coin = t & 0xffffffu;
+            const gpu::AliasEntry& e = table[bucket];
+            ++hits[coin < e.threshold ? bucket : e.alias];
         }
-        for (size_t i = 0; i < w.size(); ++i) {
-            CHECK(std::abs(implied[i] / w.size() - w[i] / total) < 1e-6);
-            if (w[i] == 0) CHECK(implied[i] == 0.0);
+        for (size_t i = 0; i < n; ++i) {
+            INFO("entry " << i << " of " << n << ", weight " << w[i]);
+            REQUIRE(table[i].alias < n);
+            CHECK(double(table[i].pmf) * 0x1.0p24 == double(hits[i]));
+            if (w[i] == 0) CHECK(hits[i] == 0);
+            if (w[i] > 0) CHECK(hits[i] > 0);
+            // Rounding each bucket's split to whole steps: at most 1.5 steps per bucket that
+            // holds i (its own and those aliased to it).
+            CHECK(std::abs(double(table[i].pmf) - w[i] / total) <= 1.5 * double(n + 1) * 0x1.0p-24);
         }
     }
+    // A weight far below one step of a bucket still gets one.
+    std::vector<gpu::AliasEntry> tiny_alias = build_alias_table({1.0, 1e-20, 0.0, 3.0});
+    CHECK(tiny_alias[1].pmf == 0x1.0p-24f);
+    CHECK(tiny_alias[2].pmf == 0.0f);
+    CHECK(tiny_alias[2].threshold == 0u);
 }
 
 TEST_CASE("discrete samplers report their pmf and match the weights (chi2)",
@@ -858,10 +866,11 @@ TEST_CASE("discrete samplers report their pmf and match the weights (chi2)",
             CHECK(wrong_pmf == 0);
             CHECK(zero_selected == 0);
             for (cl_uint i = 0; i < n; ++i) {
-                expected[i] = kSamples * w[i] / total;
-                // The distribution's pmf is the weights' within float rounding: absolute for
-                // the CDF (differences of entries near 1), relative for the alias table.
-                double tolerance = method == 0 ? 0x1.0p-23 : 1e-6 * w[i] / total;
+                // Samples against the pmf the sampler reports (what an estimator divides by).
+                expected[i] = kSamples * double(pmfs[method][i]);
+                // That pmf is the weights' up to the 2^-24 grid both are built on: two steps
+                // for the CDF, 1.5 steps per bucket holding i for the alias table.
+                double tolerance = method == 0 ? 0x1.0p-23 : 1.5 * double(n + 1) * 0x1.0p-24;
                 CHECK(std::abs(pmfs[method][i] - w[i] / total) <= tolerance);
             }
             Chi2 r = chi2_test(

@@ -84,23 +84,24 @@ std::vector<float> build_cdf(const std::vector<double>& weights) {
 std::vector<gpu::AliasEntry> build_alias_table(const std::vector<double>& weights) {
     double total = checked_total(weights);
     if (total == 0.0) return {};
-    size_t n = weights.size();
-    std::vector<gpu::AliasEntry> table(n);
+    const size_t n = weights.size();
+    // Vose's construction in double: bucket i keeps i with probability prob[i], else alias[i].
     // Scaled probabilities p_i = n·w_i/Σw, mean 1; buckets below 1 are topped up by an alias.
-    std::vector<double> p(n);
+    std::vector<double> p(n), prob(n, 0.0);
+    std::vector<uint32_t> alias(n);
     std::vector<size_t> small, large;
     size_t heaviest = 0;
     for (size_t i = 0; i < n; ++i) {
         p[i] = weights[i] / total * double(n);
         (p[i] < 1.0 ? small : large).push_back(i);
         if (weights[i] > weights[heaviest]) heaviest = i;
-        table[i] = {0.0f, gpu::uint(i), float(weights[i] / total), 0u};
+        alias[i] = uint32_t(i);
     }
     while (!small.empty() && !large.empty()) {
         size_t s = small.back(), l = large.back();
         small.pop_back();
-        table[s].prob = float(p[s]);
-        table[s].alias = gpu::uint(l);
+        prob[s] = p[s];
+        alias[s] = uint32_t(l);
         // p_l − (1 − p_s), summed in this order to lose less (Schwarz, "Darts, Dice, and Coins").
         p[l] = (p[l] + p[s]) - 1.0;
         if (p[l] < 1.0) {
@@ -109,12 +110,35 @@ std::vector<gpu::AliasEntry> build_alias_table(const std::vector<double>& weight
         }
     }
     // What is left is 1 up to rounding, and keeps its whole bucket; a zero weight never does.
-    for (size_t i : large) table[i].prob = 1.0f;
+    for (size_t i : large) prob[i] = 1.0;
     for (size_t i : small) {
         bool empty = weights[i] == 0.0;
-        table[i].prob = empty ? 0.0f : 1.0f;
-        table[i].alias = gpu::uint(empty ? heaviest : i);
+        prob[i] = empty ? 0.0 : 1.0;
+        alias[i] = uint32_t(empty ? heaviest : i);
     }
+
+    // On the kernels' grid (kernels/discrete.cl): k in [0, 2^24) falls in bucket b when
+    // b·2^24 ≤ k·n < (b+1)·2^24, i.e. for c_b values of k from ceil(b·2^24/n), whose coins
+    // k·n − b·2^24 run from s_b < n in steps of n. A threshold keeping d_b of them keeps i with
+    // probability d_b/2^24 and gives alias the other c_b − d_b; d_b = round(prob·c_b), at least
+    // one for a positive weight (so every light with power is reachable). The pmf is counted
+    // from these integers, so it is exactly the probability the kernels sample with.
+    constexpr uint64_t kGrid = uint64_t(1) << 24;
+    std::vector<uint64_t> count(n, 0);
+    std::vector<gpu::AliasEntry> table(n);
+    for (size_t b = 0; b < n; ++b) {
+        const uint64_t first = (uint64_t(b) * kGrid + n - 1) / n;     // ceil(b·2^24 / n)
+        const uint64_t end = (uint64_t(b + 1) * kGrid + n - 1) / n;   // ceil((b+1)·2^24 / n)
+        const uint64_t c = end - first, start = first * n - uint64_t(b) * kGrid;
+        uint64_t d = weights[b] > 0.0 ? uint64_t(std::llround(prob[b] * double(c))) : 0;
+        if (weights[b] > 0.0 && d == 0 && c > 0) d = 1;
+        d = std::min(d, c);
+        table[b].threshold = d == 0 ? 0u : uint32_t(start + (d - 1) * n + 1);
+        table[b].alias = alias[b];
+        count[b] += d;
+        count[alias[b]] += c - d;
+    }
+    for (size_t i = 0; i < n; ++i) table[i].pmf = float(count[i]) * 0x1.0p-24f;  // exact
     return table;
 }
 
