@@ -69,7 +69,7 @@ inline float3 estimate_light_solid_angle(const SceneView* scene, const SurfacePo
     float3 wi, y;
     float pdf_w;
     if (omega > MIN_SPHERICAL_SOLID_ANGLE && omega < MAX_SPHERICAL_SOLID_ANGLE) {
-        wi = sample_spherical_triangle(a, b, c, u);
+        wi = sample_spherical_triangle_omega(a, b, c, omega, u);
         pdf_w = 1.0f / omega;
         /* Where the direction meets the light's plane. */
         float denom = dot(wi, n_light);

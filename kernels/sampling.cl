@@ -130,7 +130,8 @@ inline float spherical_triangle_solid_angle(float3 a, float3 b, float3 c) {
     return 2.0f * atan2(triple, denom);
 }
 
-/* Direction uniform in solid angle over the spherical triangle of unit vectors a, b, c, unit.
+/* Direction uniform in solid angle over the spherical triangle of unit vectors a, b, c, unit;
+ * the _omega form takes the triangle's solid angle, when the caller already has it.
  * Arvo's two steps, with the first solved in closed form from Van Oosterom's formula instead of
  * the vertex angles (whose sum minus π cancels catastrophically for small triangles):
  * 1. c' = cos θ·a + sin θ·c⊥ on the arc a→c such that Ω(a, b, c') = u0·Ω. With t = tan(θ/2),
@@ -139,9 +140,9 @@ inline float spherical_triangle_solid_angle(float3 a, float3 b, float3 c) {
  * χ²-tested from 4 sr down to 1e-3 sr; inside the triangle and invertible down to 1e-7 sr and
  * slivers, but callers sample lights below ~3e-4 sr by area instead, as pbrt-v4 does. Never
  * NaN: a degenerate triangle (Ω = 0) gives the normalized vertex average. */
-inline float3 sample_spherical_triangle(float3 a, float3 b, float3 c, float2 u) {
+inline float3 sample_spherical_triangle_omega(float3 a, float3 b, float3 c, float omega,
+                                              float2 u) {
     float3 fallback = normalize_or(a + b + c, a);
-    float omega = spherical_triangle_solid_angle(a, b, c);
     if (!(omega > 0.0f) || !isfinite(omega)) return fallback;
 
     /* Step 1: c' splits off the sub-triangle (a, b, c') of solid angle u0·Ω. Differences to a
@@ -151,11 +152,21 @@ inline float3 sample_spherical_triangle(float3 a, float3 b, float3 c, float2 u) 
     float T = fabs(dot(ba, cross(c_perp, a)));                   /* a·(b×c⊥) */
     float b_dot_c_perp = dot(ba, c_perp);                        /* b·c⊥, as a·c⊥ = 0 */
     float one_plus_ab = 2.0f - 0.5f * dot(ba, ba);               /* 1 + a·b */
-    float half_area = 0.5f * u.x * omega;
-    float sh = sin(half_area), ch = cos(half_area);
-    float arc_ac = 2.0f * atan2(length(ac), length(c + a));
-    float theta = min(2.0f * atan2(sh * one_plus_ab, T * ch - sh * b_dot_c_perp), arc_ac);
-    float3 cp = cos(theta) * a + sin(theta) * c_perp;
+    /* sin and cos of u0·Ω/2 in [0, π) as sinpi/cospi of its fraction of π: no general argument
+     * reduction (PoCL's was a quarter of this estimator's time with atan2). */
+    float turns = u.x * omega * (0.5f * M_1_PI_F);
+    float sh = sinpi(turns), ch = cospi(turns);
+    /* θ/2 = atan2(y, x), but only cos θ and sin θ are needed: the double-angle formulas of the
+     * vector (x, y). θ is at most the arc a→c, whose half is atan2(|c − a|, |c + a|); compared
+     * by the sign of a 2D cross product, both half-angles being in [0, π]. */
+    float y = sh * one_plus_ab, x = T * ch - sh * b_dot_c_perp;
+    float3 cp;
+    if (y * length(c + a) >= x * length(ac)) {
+        cp = c; /* at or beyond the end of the arc (rounding): c' = c */
+    } else {
+        float r2 = x * x + y * y;
+        cp = (r2 > 0.0f) ? ((x * x - y * y) * a + (2.0f * x * y) * c_perp) / r2 : a;
+    }
 
     /* Step 2: along the arc b→c', uniform in 1 − cos of the arc length from b. */
     float3 bc = cp - b;
@@ -164,6 +175,10 @@ inline float3 sample_spherical_triangle(float3 a, float3 b, float3 c, float2 u) 
     float3 bc_perp = normalize_or(bc - dot(bc, b) * b, fallback); /* tangent of arc b→c' at b */
     float3 w = normalize_or((1.0f - one_minus_z) * b + sin_arc * bc_perp, fallback);
     return (isfinite(w.x) && isfinite(w.y) && isfinite(w.z)) ? w : fallback;
+}
+
+inline float3 sample_spherical_triangle(float3 a, float3 b, float3 c, float2 u) {
+    return sample_spherical_triangle_omega(a, b, c, spherical_triangle_solid_angle(a, b, c), u);
 }
 
 /* Density of sample_spherical_triangle with respect to solid angle: 1/Ω when w is inside the
