@@ -27,10 +27,18 @@ void ProgressBar::update(uint32_t done, uint32_t total, const std::vector<Device
     if (done < total && drawn_ && now - last_ < std::chrono::milliseconds(100)) return;
     last_ = now;
     drawn_ = true;
-    double elapsed = std::chrono::duration<double>(now - start_).count();
     double fraction = progress_fraction(done, total, samples_per_spp_, devices);
-    double rate = elapsed > 0 ? fraction * double(total) * samples_per_spp_ / elapsed : 0.0;
-    double left = fraction > 0 ? elapsed * (1 - fraction) / fraction : 0.0;
+    if (!started_ && fraction > 0) started_ = true, first_ = now, first_fraction_ = fraction;
+    // Rate and time left from the work done since the first report (none yet: unknown).
+    double since = started_ ? std::chrono::duration<double>(now - first_).count() : 0.0;
+    double progress = fraction - first_fraction_;
+    bool known = started_ && since > 0 && progress > 0;
+    double rate = known ? progress * double(total) * samples_per_spp_ / since : 0.0;
+    char left[32] = "?";
+    if (fraction >= 1.0)
+        std::snprintf(left, sizeof left, "0.0");
+    else if (known)
+        std::snprintf(left, sizeof left, "%.1f", since * (1 - fraction) / progress);
     const int width = 30;
     int filled = int(fraction * width + 0.5);
     char bar[width + 1];
@@ -47,7 +55,7 @@ void ProgressBar::update(uint32_t done, uint32_t total, const std::vector<Device
             shares += share;
         }
     }
-    std::fprintf(stderr, "\r[%s] %3d%% %u/%u spp  %.2f Msamples/s  %.1f s left%s ", bar,
+    std::fprintf(stderr, "\r[%s] %3d%% %u/%u spp  %.2f Msamples/s  %s s left%s ", bar,
                  int(fraction * 100 + 0.5), done, total, rate * 1e-6, left, shares.c_str());
     std::fflush(stderr);
 }

@@ -29,6 +29,11 @@ private:
     uint64_t samples_per_spp_;
     bool drawn_ = false;
     std::chrono::steady_clock::time_point start_, last_;
+    // The first update with work done: rate and time left are measured from it, so that kernel
+    // compilation and scene upload before it do not count as slow rendering.
+    bool started_ = false;
+    std::chrono::steady_clock::time_point first_;
+    double first_fraction_ = 0;
 };
 
 }  // namespace mcrt
