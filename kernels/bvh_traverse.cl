@@ -14,16 +14,14 @@
  * at levels above the deepest, so its peak is lower. Pushes are still bounds-checked. */
 #define BVH_STACK_SIZE (3 * MCRT_BVH4_MAX_DEPTH)
 
-#define NO_HIT 0xffffffffu
-
 /* γ(3) = 3ε / (1 − 3ε), ε = 2^-24 (PBRT 3rd ed. 3.9.1). */
 #define MCRT_GAMMA3 1.7881396e-7f
 
 typedef struct {
     float t;
     float b1, b2;  /* barycentrics of p1, p2 */
-    uint triangle; /* packet lane of the hit, 4 · packet + lane (TriangleInfo's index), NO_HIT
-                      on a miss */
+    uint lane;     /* packet lane of the hit, 4 · packet + lane (TriangleInfo's index),
+                      MCRT_NO_HIT on a miss */
 } Hit;
 
 /* The ray as the 4-wide slab test reads it: origin and inverse direction splatted, and per axis
@@ -77,7 +75,7 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePa
     Hit hit;
     hit.t = t_max;
     hit.b1 = hit.b2 = 0.0f;
-    hit.triangle = NO_HIT;
+    hit.lane = MCRT_NO_HIT;
 
     BoxRay b = make_box_ray(r);
     PacketRay q = make_packet_ray(r);
@@ -134,7 +132,7 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePa
                         hit.t = t[i];
                         hit.b1 = u[i];
                         hit.b2 = v[i];
-                        hit.triangle = MCRT_PACKET_WIDTH * (ref + k / MCRT_PACKET_WIDTH) + i;
+                        hit.lane = MCRT_PACKET_WIDTH * (ref + k / MCRT_PACKET_WIDTH) + i;
                     }
                 }
             }

@@ -2,9 +2,6 @@
 #ifndef MCRT_GEOMETRY_CL
 #define MCRT_GEOMETRY_CL
 
-#define MCRT_PI 3.14159265358979323846f
-#define MCRT_INV_PI 0.31830988618379067154f
-
 /* A ray with what the watertight test and the slab test need precomputed. */
 typedef struct {
     float3 org;
@@ -13,8 +10,6 @@ typedef struct {
     uint4 shear_axes; /* kx, ky, kz, 3 (Woop et al. 2013) */
     float3 shear;     /* Sx, Sy, Sz */
 } Ray;
-
-inline float max_component(float3 v) { return fmax(v.x, fmax(v.y, v.z)); }
 
 inline Ray make_ray(float3 org, float3 dir) {
     Ray r;

@@ -2,27 +2,48 @@
 #include "shared_types.h"
 #include "camera.cl"
 #include "estimators.cl"
+#include "user_estimator.cl"
+
+#if !defined(MCRT_ESTIMATE)
+#error "no estimator selected: the host defines MCRT_ESTIMATE (host/render/variants.cpp)"
+#endif
+
+/* Radiance arriving along a camera ray: Le at the first hit plus the estimator's estimate of
+ * the reflected light; a ray leaving the scene sees black, or the sky for estimators that use
+ * it (-D ESTIMATOR_USES_SKY; DESIGN.md "Radiometric contract"). Counts the rays in *rays. */
+inline float3 radiance(const SceneView* scene, const Ray* r, const SampleStream* stream,
+                       uint* rays) {
+    *rays += 1u;
+    Hit hit = bvh_closest_hit(scene->nodes, scene->packets, r, MAXFLOAT);
+#if defined(ESTIMATOR_USES_SKY)
+    if (hit.lane == MCRT_NO_HIT) return scene->env.sky;
+#else
+    if (hit.lane == MCRT_NO_HIT) return (float3)(0.0f);
+#endif
+    SurfacePoint sp = surface_point(scene, r, &hit);
+    float3 L = emitted_radiance(&sp);
+    L += MCRT_ESTIMATE(scene, &sp, stream, rays);
+    return L;
+}
 
 /* One work-item per pixel sample of a batch. Work-item g renders sample
- * sample_begin + g % batch_samples (of spp in all) of pixel pixel_begin + g / batch_samples
- * < pixel_end (samples of a pixel adjacent) and writes samples[g] = (radiance, rays traced). */
+ * p.sample_begin + g % p.batch_samples (of p.spp in all) of pixel
+ * p.pixel_begin + g / p.batch_samples < p.pixel_end (samples of a pixel adjacent) and writes
+ * samples[g] = (radiance, rays traced). Arguments in the order of RenderArgument. */
 kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* packets,
-                   global const TriangleInfo* triangle_info,
-                   global const Material* materials, global const Light* lights,
-                   global const float* light_cdf, global const AliasEntry* light_alias,
-                   uint light_count, global const CameraGpu* camera, uint width, uint height,
-                   uint seed, uint spp, float4 sky, float ao_distance, uint pixel_begin,
-                   uint pixel_end, uint sample_begin, uint batch_samples,
-                   global float4* samples) {
+                   global const TriangleInfo* triangle_info, global const Material* materials,
+                   global const Light* lights, global const float* light_cdf,
+                   global const AliasEntry* light_alias, global const CameraGpu* camera,
+                   global float4* samples, RenderParams p) {
     size_t g = get_global_id(0);
-    uint pixel = pixel_begin + (uint)(g / batch_samples);
-    if (pixel >= pixel_end) return; /* the global size is rounded up to whole work-groups */
+    uint pixel = p.pixel_begin + (uint)(g / p.batch_samples);
+    if (pixel >= p.pixel_end) return; /* the global size is rounded up to whole work-groups */
 
     SampleStream stream;
     stream.pixel = pixel;
-    stream.sample = sample_begin + (uint)(g % batch_samples);
-    stream.sample_count = spp;
-    stream.seed = seed;
+    stream.sample = p.sample_begin + (uint)(g % p.batch_samples);
+    stream.sample_count = p.spp;
+    stream.seed = p.seed;
 
     SceneView scene;
     scene.nodes = nodes;
@@ -32,17 +53,15 @@ kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* pa
     scene.lights.lights = lights;
     scene.lights.light_cdf = light_cdf;
     scene.lights.alias = light_alias;
-    scene.lights.light_count = light_count;
+    scene.lights.light_count = p.light_count;
+    scene.env.sky = p.sky.xyz;
+    scene.env.ao_distance = p.ao_distance;
 
-    Environment env;
-    env.sky = sky.xyz;
-    env.ao_distance = ao_distance;
-
-    float3 dir = camera_direction(camera, pixel % width, pixel / width,
-                                  sample_2d(&stream, DIM_PIXEL_JITTER), width, height);
+    float3 dir = camera_direction(camera, pixel % p.width, pixel / p.width,
+                                  sample_2d(&stream, DIM_PIXEL_JITTER), p.width, p.height);
     Ray r = make_ray(camera->eye.xyz, dir);
     uint rays = 0u;
-    float3 L = radiance(&scene, &r, &stream, &env, &rays);
+    float3 L = radiance(&scene, &r, &stream, &rays);
     samples[g] = (float4)(L, (float)rays);
 }
 
@@ -81,16 +100,14 @@ kernel void reduce_chunks(global const float4* samples, uint batch_samples, uint
     sums_sq[g] = (float4)(s2, rays);
 }
 
-/* Writes the device's sizeof of each shared struct, to check them against the host's. */
-kernel void shared_type_sizes(global uint* sizes) {
+/* The device's view of every shared struct, in the order of MCRT_SHARED_LAYOUT: for each struct
+ * its size and alignment, then each listed member's offset. */
+#define MCRT_PROBE_TYPE(T, size, align) \
+    layout[k++] = (uint)sizeof(T);      \
+    layout[k++] = (uint)__alignof__(T);
+#define MCRT_PROBE_FIELD(T, member, offset) layout[k++] = (uint)__builtin_offsetof(T, member);
+kernel void shared_type_layout(global uint* layout) {
     if (get_global_id(0) != 0) return;
-    sizes[0] = sizeof(BvhNode);
-    sizes[1] = sizeof(Triangle);
-    sizes[2] = sizeof(Material);
-    sizes[3] = sizeof(Light);
-    sizes[4] = sizeof(CameraGpu);
-    sizes[5] = sizeof(AliasEntry);
-    sizes[6] = sizeof(Bvh4Node);
-    sizes[7] = sizeof(TrianglePacket);
-    sizes[8] = sizeof(TriangleInfo);
+    uint k = 0u;
+    MCRT_SHARED_LAYOUT(MCRT_PROBE_TYPE, MCRT_PROBE_FIELD)
 }

@@ -31,13 +31,16 @@ typedef struct {
     uint seed;
 } SampleStream;
 
-/* Dimensions of the stream, shared by every estimator so that two estimators can be compared
- * on the same samples. */
+/* Dimensions of the stream, shared by every estimator (a user's too) so that two estimators
+ * are compared on the same samples (common random numbers). A 2D dimension d uses d and d + 1. */
 #define DIM_PIXEL_JITTER 0u   /* 2D */
 #define DIM_LIGHT_SELECT 2u   /* 1D */
 #define DIM_LIGHT_POINT 3u    /* 2D: point on the light, or direction in its spherical triangle */
-#define DIM_DIRECTION 5u      /* 2D: hemisphere direction (hemisphere, MIS, ambient) */
+#define DIM_DIRECTION 5u      /* 2D: hemisphere or BSDF direction (hemisphere, MIS, ambient) */
 #define DIM_PIXEL_ROTATION 7u /* 2D, per pixel: rotation of the Fibonacci spiral */
+/* Dimensions DIM_USER, DIM_USER + 1, ... belong to users' estimators: no built-in code uses
+ * them, now or later (docs/ESTIMATORS.md). */
+#define DIM_USER 0x100000u
 
 /* Independent uniform number of dimension dim: pcg4d(pixel, sample, dim, seed).x. */
 inline float independent_1d(uint pixel, uint sample, uint dim, uint seed) {

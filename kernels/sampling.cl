@@ -4,7 +4,8 @@
 #ifndef MCRT_SAMPLING_CL
 #define MCRT_SAMPLING_CL
 
-#define INV_PI_F 0.318309886183790672f
+#include "shared_types.h"
+
 #define INV_2PI_F 0.159154943091895336f
 
 /* v / |v|, or fallback when v is zero or not finite. */
@@ -86,7 +87,7 @@ inline float2 invert_disk_concentric(float2 p) {
     float r = hypot(p.x, p.y);
     float phi = atan2(p.y, p.x);                     /* (−π, π] */
     if (phi < -0.25f * M_PI_F) phi += 2.0f * M_PI_F; /* [−π/4, 7π/4) */
-    float k = 4.0f * INV_PI_F, a, b;
+    float k = 4.0f * MCRT_INV_PI, a, b;
     if (phi < 0.25f * M_PI_F) { /* right sector: r = a */
         a = r;
         b = r * phi * k;
@@ -115,7 +116,7 @@ inline float3 sample_hemisphere_cosine(float2 u) {
 }
 
 /* Density of sample_hemisphere_cosine with respect to solid angle: cosθ/π above the horizon. */
-inline float sample_hemisphere_cosine_pdf_w(float3 w) { return w.z > 0.0f ? w.z * INV_PI_F : 0.0f; }
+inline float sample_hemisphere_cosine_pdf_w(float3 w) { return w.z > 0.0f ? w.z * MCRT_INV_PI : 0.0f; }
 
 inline float2 invert_hemisphere_cosine(float3 w) { return invert_disk_concentric(w.xy); }
 

@@ -1,22 +1,30 @@
-/* The device's view of the scene, and what a camera ray found. */
+/* The device's view of the scene, and the surface point a ray found. */
 #ifndef MCRT_SCENE_CL
 #define MCRT_SCENE_CL
 
 #include "bvh_traverse.cl"
 #include "lights.cl"
 
+/* The uniform environment of the ambient estimators (DESIGN.md "Radiometric contract"). */
+typedef struct {
+    float3 sky;        /* radiance of the uniform sky */
+    float ao_distance; /* occlusion range; 0 = unbounded */
+} Environment;
+
 typedef struct {
     global const Bvh4Node* nodes;
-    global const TrianglePacket* packets; /* the leaves' triangles, for ray queries */
+    global const TrianglePacket* packets;     /* the leaves' triangles, for ray queries */
     global const TriangleInfo* triangle_info; /* per packet lane: material, light */
     global const Material* materials;
     LightSet lights;
+    Environment env;
 } SceneView;
 
 /* A surface point seen along a ray. */
 typedef struct {
     float3 p;      /* from barycentrics, not from o + t·d (Wächter & Binder 2019) */
     float3 n;      /* unit geometric normal, flipped toward the incoming ray */
+    float3 wo;     /* unit, toward where the ray came from */
     bool front;    /* the ray arrived on the counter-clockwise (front) side */
     uint light;    /* index of its Light plus one; 0 when it is not a light */
     Material material;
@@ -24,17 +32,18 @@ typedef struct {
 
 inline SurfacePoint surface_point(const SceneView* scene, const Ray* r, const Hit* hit) {
     /* The vertices from the hit's packet lane: coordinate a of vertex k at v[3k + a].lane. */
-    uint lane = hit->triangle % MCRT_PACKET_WIDTH;
+    uint lane = hit->lane % MCRT_PACKET_WIDTH;
     global const float* v =
-        (global const float*)scene->packets[hit->triangle / MCRT_PACKET_WIDTH].v + lane;
+        (global const float*)scene->packets[hit->lane / MCRT_PACKET_WIDTH].v + lane;
     float3 p0 = (float3)(v[0], v[4], v[8]);
     float3 e1 = (float3)(v[12], v[16], v[20]) - p0, e2 = (float3)(v[24], v[28], v[32]) - p0;
-    TriangleInfo info = scene->triangle_info[hit->triangle];
+    TriangleInfo info = scene->triangle_info[hit->lane];
     SurfacePoint sp;
     sp.p = p0 + hit->b1 * e1 + hit->b2 * e2;
     float3 ng = normalize(cross(e1, e2));
     sp.front = dot(ng, r->dir) < 0.0f;
     sp.n = sp.front ? ng : -ng;
+    sp.wo = -normalize(r->dir);
     sp.light = info.light;
     sp.material = scene->materials[info.material];
     return sp;
@@ -46,12 +55,34 @@ inline float3 emitted_radiance(const SurfacePoint* sp) {
     return emits ? sp->material.Le.xyz : (float3)(0.0f);
 }
 
-/* True if nothing blocks the segment between the offset origins of a and b. */
+/* True if nothing blocks the segment between the offset origins of a and b; na and nb are the
+ * geometric normals on the sides the segment leaves a and reaches b. */
 inline bool visible(const SceneView* scene, float3 a, float3 na, float3 b, float3 nb) {
     float3 o = offset_ray_origin(a, na);
     float3 target = offset_ray_origin(b, nb);
     Ray shadow = make_ray(o, target - o);
     return !bvh_any_hit(scene->nodes, scene->packets, &shadow, 1.0f);
+}
+
+/* The first surface along direction wi (unit, world) from sp, offset off its surface; false
+ * when the ray leaves the scene. Counts the ray in *rays. */
+inline bool trace_from(const SceneView* scene, const SurfacePoint* sp, float3 wi, uint* rays,
+                       SurfacePoint* seen) {
+    *rays += 1u;
+    Ray r = make_ray(offset_ray_origin(sp->p, sp->n), wi);
+    Hit hit = bvh_closest_hit(scene->nodes, scene->packets, &r, MAXFLOAT);
+    if (hit.lane == MCRT_NO_HIT) return false;
+    *seen = surface_point(scene, &r, &hit);
+    return true;
+}
+
+/* True if the ray from sp along wi (unit, world) leaves the scene within t_max (MAXFLOAT:
+ * unbounded). Counts the ray in *rays. */
+inline bool escapes(const SceneView* scene, const SurfacePoint* sp, float3 wi, float t_max,
+                    uint* rays) {
+    *rays += 1u;
+    Ray r = make_ray(offset_ray_origin(sp->p, sp->n), wi);
+    return !bvh_any_hit(scene->nodes, scene->packets, &r, t_max);
 }
 
 #endif

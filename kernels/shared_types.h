@@ -1,17 +1,38 @@
 /* Structs shared by the host (C++17) and the kernels (OpenCL C 1.2), declared once.
- * Only float, uint and float4 members; padding explicit; each size stated and checked by a
- * static_assert on the host and by the `shared_type_sizes` kernel on the device. */
+ * Only float, uint and float4 members; padding explicit; each size, alignment and offset listed
+ * once in MCRT_SHARED_LAYOUT (at the end), checked by static_assert on the host and by the
+ * `shared_type_layout` kernel on the device. */
 #ifndef MCRT_SHARED_TYPES_H
 #define MCRT_SHARED_TYPES_H
 
 #ifndef __OPENCL_VERSION__
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
 namespace mcrt::gpu {
 struct alignas(16) float4 {
     float x, y, z, w;
 };
 using uint = std::uint32_t;
+
+/* The kernels' as_float / as_uint on the host: uint bits stored in a float member and back. */
+inline float as_float(uint u) {
+    float f;
+    std::memcpy(&f, &u, sizeof f);
+    return f;
+}
+inline uint as_uint(float f) {
+    uint u;
+    std::memcpy(&u, &f, sizeof u);
+    return u;
+}
 #endif
+
+/* A triangle or packet-lane index that names nothing: a ray's miss, an unused packet lane. */
+#define MCRT_NO_HIT 0xffffffffu
+
+/* 1/π, for the Lambertian f_r = albedo/π and cosine densities. */
+#define MCRT_INV_PI 0.318309886183790671538f
 
 /* Samples of one pixel are summed in chunks of this many consecutive sample indices, aligned
  * to multiples of it; batches start on chunk boundaries, so the floating-point sums, and the
@@ -52,7 +73,7 @@ typedef struct {
 /* Up to four triangles of one leaf in SoA form, 160 bytes, so that one watertight test in float4
  * arithmetic covers all four (Wald, Benthin, Boulos 2008; Embree's triangle4). v[3k + a] holds
  * coordinate a (x, y, z) of vertex k of the four lanes; index[i] is lane i's triangle in leaf
- * order (the Triangle array), NO_HIT (0xffffffff) for an unused lane, whose vertices are 0. */
+ * order (the Triangle array), MCRT_NO_HIT for an unused lane, whose vertices are 0. */
 typedef struct {
     float4 v[9];    /* 0: x0, y0, z0, x1, y1, z1, x2, y2, z2 */
     uint index[4];  /* 144 */
@@ -121,16 +142,73 @@ typedef struct {
     float4 forward;
 } CameraGpu;
 
+/* The per-render values of the render kernel, passed by value as its last argument, 64 bytes.
+ * Values that change per render or per launch live here, never in -D options, so they never
+ * trigger a rebuild (STYLE.md). */
+typedef struct {
+    float4 sky;         /* .xyz uniform sky radiance (ambient estimators), .w unused */
+    float ao_distance;  /* ambient occlusion range; 0 = unbounded */
+    uint width, height; /* image size in pixels */
+    uint seed;
+    uint spp;           /* samples per pixel of the whole render (strata, spiral points) */
+    uint light_count;
+    uint pixel_begin, pixel_end; /* this launch: pixels [pixel_begin, pixel_end) */
+    uint sample_begin;  /* this launch: samples [sample_begin, sample_begin + batch_samples) */
+    uint batch_samples; /*   of each pixel */
+    uint pad0, pad1;
+} RenderParams;
+
+/* The render kernel's arguments in order (kernels/render.cl); the host binds them all in one
+ * place (bind_render_arguments, host/render/device_worker.cpp). */
+enum RenderArgument {
+    RENDER_ARG_NODES,         /* global const Bvh4Node* */
+    RENDER_ARG_PACKETS,       /* global const TrianglePacket* */
+    RENDER_ARG_TRIANGLE_INFO, /* global const TriangleInfo*: per packet lane */
+    RENDER_ARG_MATERIALS,     /* global const Material* */
+    RENDER_ARG_LIGHTS,        /* global const Light* */
+    RENDER_ARG_LIGHT_CDF,     /* global const float*: light_count + 1 entries */
+    RENDER_ARG_LIGHT_ALIAS,   /* global const AliasEntry*: light_count entries */
+    RENDER_ARG_CAMERA,        /* global const CameraGpu* */
+    RENDER_ARG_SAMPLES,       /* global float4*: out, one per work-item */
+    RENDER_ARG_PARAMS,        /* RenderParams, by value */
+    RENDER_ARG_COUNT
+};
+
+/* Size, alignment and field offsets of every shared struct, listed once: the host checks them
+ * with static_assert (below), the device reports its own through the `shared_type_layout`
+ * kernel (kernels/render.cl) and a test compares the two. TYPE(T, size, align) opens a struct,
+ * FIELD(T, member, offset) follows for each member. */
+#define MCRT_SHARED_LAYOUT(TYPE, FIELD)                                                          \
+    TYPE(BvhNode, 32, 16) FIELD(BvhNode, lo, 0) FIELD(BvhNode, hi, 16)                          \
+    TYPE(Bvh4Node, 128, 16) FIELD(Bvh4Node, lo_x, 0) FIELD(Bvh4Node, hi_x, 16)                  \
+    FIELD(Bvh4Node, lo_y, 32) FIELD(Bvh4Node, hi_y, 48) FIELD(Bvh4Node, lo_z, 64)               \
+    FIELD(Bvh4Node, hi_z, 80) FIELD(Bvh4Node, child, 96) FIELD(Bvh4Node, count, 112)            \
+    TYPE(TrianglePacket, 160, 16) FIELD(TrianglePacket, v, 0) FIELD(TrianglePacket, index, 144) \
+    TYPE(TriangleInfo, 8, 4) FIELD(TriangleInfo, material, 0) FIELD(TriangleInfo, light, 4)     \
+    TYPE(Triangle, 48, 16) FIELD(Triangle, p0, 0) FIELD(Triangle, p1, 16)                       \
+    FIELD(Triangle, p2, 32)                                                                     \
+    TYPE(Material, 48, 16) FIELD(Material, albedo, 0) FIELD(Material, Le, 16)                   \
+    FIELD(Material, flags, 32)                                                                  \
+    TYPE(Light, 64, 16) FIELD(Light, p0, 0) FIELD(Light, p1, 16) FIELD(Light, p2, 32)           \
+    FIELD(Light, Le, 48)                                                                        \
+    TYPE(AliasEntry, 16, 4) FIELD(AliasEntry, threshold, 0) FIELD(AliasEntry, alias, 4)         \
+    FIELD(AliasEntry, pmf, 8)                                                                   \
+    TYPE(CameraGpu, 64, 16) FIELD(CameraGpu, eye, 0) FIELD(CameraGpu, right, 16)                \
+    FIELD(CameraGpu, up, 32) FIELD(CameraGpu, forward, 48)                                      \
+    TYPE(RenderParams, 64, 16) FIELD(RenderParams, sky, 0) FIELD(RenderParams, ao_distance, 16) \
+    FIELD(RenderParams, width, 20) FIELD(RenderParams, height, 24) FIELD(RenderParams, seed, 28) \
+    FIELD(RenderParams, spp, 32) FIELD(RenderParams, light_count, 36)                           \
+    FIELD(RenderParams, pixel_begin, 40) FIELD(RenderParams, pixel_end, 44)                     \
+    FIELD(RenderParams, sample_begin, 48) FIELD(RenderParams, batch_samples, 52)
+
 #ifndef __OPENCL_VERSION__
-static_assert(sizeof(BvhNode) == 32 && alignof(BvhNode) == 16, "BvhNode layout");
-static_assert(sizeof(Bvh4Node) == 128 && alignof(Bvh4Node) == 16, "Bvh4Node layout");
-static_assert(sizeof(TrianglePacket) == 160 && alignof(TrianglePacket) == 16, "TrianglePacket layout");
-static_assert(sizeof(TriangleInfo) == 8 && alignof(TriangleInfo) == 4, "TriangleInfo layout");
-static_assert(sizeof(Triangle) == 48 && alignof(Triangle) == 16, "Triangle layout");
-static_assert(sizeof(Material) == 48 && alignof(Material) == 16, "Material layout");
-static_assert(sizeof(Light) == 64 && alignof(Light) == 16, "Light layout");
-static_assert(sizeof(AliasEntry) == 16 && alignof(AliasEntry) == 4, "AliasEntry layout");
-static_assert(sizeof(CameraGpu) == 64 && alignof(CameraGpu) == 16, "CameraGpu layout");
+#define MCRT_CHECK_TYPE(T, size, align) \
+    static_assert(sizeof(T) == size && alignof(T) == align, #T " size or alignment");
+#define MCRT_CHECK_FIELD(T, member, offset) \
+    static_assert(offsetof(T, member) == offset, #T "." #member " offset");
+MCRT_SHARED_LAYOUT(MCRT_CHECK_TYPE, MCRT_CHECK_FIELD)
+#undef MCRT_CHECK_TYPE
+#undef MCRT_CHECK_FIELD
 }  // namespace mcrt::gpu
 #endif
 

@@ -4,7 +4,7 @@
 #include "bvh_traverse.cl"
 
 /* Closest hit of ray g: origins[g].xyz, directions[g].xyz, t_max in origins[g].w. Writes
- * hits[g] = (t, b1, b2, leaf-order triangle index as uint bits; NO_HIT on a miss). */
+ * hits[g] = (t, b1, b2, leaf-order triangle index as uint bits; MCRT_NO_HIT on a miss). */
 kernel void trace_closest(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                           global const float4* origins, global const float4* directions,
                           uint ray_count, global float4* hits) {
@@ -12,9 +12,9 @@ kernel void trace_closest(global const Bvh4Node* nodes, global const TrianglePac
     if (g >= ray_count) return;
     Ray r = make_ray(origins[g].xyz, directions[g].xyz);
     Hit h = bvh_closest_hit(nodes, packets, &r, origins[g].w);
-    uint triangle = h.triangle == NO_HIT
-                        ? NO_HIT
-                        : packets[h.triangle / MCRT_PACKET_WIDTH].index[h.triangle % MCRT_PACKET_WIDTH];
+    uint triangle = h.lane == MCRT_NO_HIT
+                        ? MCRT_NO_HIT
+                        : packets[h.lane / MCRT_PACKET_WIDTH].index[h.lane % MCRT_PACKET_WIDTH];
     hits[g] = (float4)(h.t, h.b1, h.b2, as_float(triangle));
 }
 

@@ -14,6 +14,7 @@
 #include "bvh/bvh.h"
 #include "cl/cl_error.h"
 #include "cl/device.h"
+#include "cli/device_select.h"
 #include "cl/program.h"
 #include "common/error.h"
 #include "render/gpu_scene.h"
@@ -25,19 +26,12 @@ namespace {
 // Fixed seeds: the same scene and resolution always give the same rays.
 constexpr uint64_t kShadowSeed = 0x5348414430ull;   // "SHAD0"
 constexpr uint64_t kAmbientSeed = 0x414d424930ull;  // "AMBI0"
-constexpr uint32_t kNoHit = 0xffffffffu;
 
 double median(std::vector<double> v) {
     if (v.empty()) return 0.0;
     std::sort(v.begin(), v.end());
     size_t n = v.size();
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-uint32_t float_bits(float f) {
-    uint32_t u;
-    std::memcpy(&u, &f, sizeof u);
-    return u;
 }
 
 // What one tracer reported on one ray kind.
@@ -77,7 +71,7 @@ class DeviceTracer {
         hits->assign(rays.size(), gpu::float4{0, 0, 0, 0});
         Timing timing =
             run("trace_closest", rays, repeats, hits->data(), sizeof(gpu::float4), reference);
-        for (const gpu::float4& h : *hits) timing.hits += float_bits(h.w) != kNoHit;
+        for (const gpu::float4& h : *hits) timing.hits += gpu::as_uint(h.w) != MCRT_NO_HIT;
         return timing;
     }
 
@@ -168,12 +162,7 @@ struct KindResult {
 }  // namespace
 
 int run_bench(const BenchOptions& o, const std::function<void(const std::string&)>& warn) {
-    std::vector<DeviceInfo> devices = enumerate_devices(warn);
-    if (devices.empty())
-        throw RuntimeError("no OpenCL device found (is an ICD such as PoCL installed?)");
-    if (o.device < 0 || size_t(o.device) >= devices.size())
-        throw InputError("--device " + std::to_string(o.device) + ": no such device (" +
-                         std::to_string(devices.size()) + " found; see `mcrt devices`)");
+    DeviceInfo device = select_device(o.device, warn);
 
     Scene scene = load_gltf(o.scene, warn);
     if (scene.triangle_count() == 0) warn(o.scene + ": the scene has no triangles");
@@ -183,7 +172,7 @@ int run_bench(const BenchOptions& o, const std::function<void(const std::string&
     Bvh bvh = build_bvh(scene, o.bvh);
     double bytes_per_triangle =
         scene.triangle_count() ? double(bvh.stats.bytes) / double(scene.triangle_count()) : 0.0;
-    DeviceTracer tracer(devices[size_t(o.device)], bvh);
+    DeviceTracer tracer(device, bvh);
 #ifdef MCRT_HAVE_EMBREE
     EmbreeTracer embree(scene);
 #endif
@@ -210,12 +199,12 @@ int run_bench(const BenchOptions& o, const std::function<void(const std::string&
             r.has_embree = true;
             r.embree.seconds_median = reference.seconds_median;
             for (size_t k = 0; k < primary.size(); ++k) {
-                uint32_t leaf = float_bits(primary_hits[k].w);
-                bool mcrt_hit = leaf != kNoHit, embree_hit = embree_triangle[k] != kNoHit;
+                uint32_t leaf = gpu::as_uint(primary_hits[k].w);
+                bool mcrt_hit = leaf != MCRT_NO_HIT, embree_hit = embree_triangle[k] != MCRT_NO_HIT;
                 r.embree.hits += embree_hit;
                 if (mcrt_hit != embree_hit) {
                     ++r.hit_mismatches;
-                } else if (mcrt_hit && float_bits(bvh.triangles[leaf].p1.w) != embree_triangle[k]) {
+                } else if (mcrt_hit && gpu::as_uint(bvh.triangles[leaf].p1.w) != embree_triangle[k]) {
                     ++r.triangle_mismatches;  // p1.w holds the scene's triangle index
                 }
             }

@@ -76,9 +76,8 @@ std::vector<SurfacePoint> surface_points(const RayBatch& primary,
                                          const std::vector<gpu::Triangle>& triangles) {
     std::vector<SurfacePoint> points;
     for (size_t k = 0; k < hits.size(); ++k) {
-        uint32_t leaf;
-        std::memcpy(&leaf, &hits[k].w, sizeof leaf);
-        if (leaf == 0xffffffffu || leaf >= triangles.size()) continue;
+        const uint32_t leaf = gpu::as_uint(hits[k].w);
+        if (leaf == MCRT_NO_HIT || leaf >= triangles.size()) continue;
         const gpu::Triangle& tri = triangles[leaf];
         glm::vec3 o = to_vec3(primary.origins[k]), d = to_vec3(primary.directions[k]);
         glm::vec3 n =

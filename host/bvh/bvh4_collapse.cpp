@@ -15,14 +15,8 @@ namespace {
 // Empty slots: inverted and finite, as kernels may assume no infinities (see Bvh4Node).
 constexpr float kHuge = 1e30f;
 
-uint32_t bits(float f) {
-    uint32_t u;
-    std::memcpy(&u, &f, sizeof u);
-    return u;
-}
-
-uint32_t first_of(const gpu::BvhNode& n) { return bits(n.lo.w); }
-uint32_t count_of(const gpu::BvhNode& n) { return bits(n.hi.w); }
+uint32_t first_of(const gpu::BvhNode& n) { return gpu::as_uint(n.lo.w); }
+uint32_t count_of(const gpu::BvhNode& n) { return gpu::as_uint(n.hi.w); }
 
 // Surface area in double, 0 for an inverted (empty) box (PBRT 3rd ed. 2.1.3).
 double area(const float lo[3], const float hi[3]) {
@@ -178,8 +172,8 @@ std::vector<gpu::TrianglePacket> pack_leaves(std::vector<gpu::Bvh4Node>& nodes,
                 throw RuntimeError("BVH packets: too many packets for 32-bit indices");
             node.child[s] = uint32_t(packets.size());
             for (uint32_t k = 0; k < count; k += MCRT_PACKET_WIDTH) {
-                gpu::TrianglePacket p{};  // unused lanes: vertices 0, index NO_HIT
-                for (int i = 0; i < MCRT_PACKET_WIDTH; ++i) p.index[i] = 0xffffffffu;
+                gpu::TrianglePacket p{};  // unused lanes: vertices 0, index MCRT_NO_HIT
+                for (int i = 0; i < MCRT_PACKET_WIDTH; ++i) p.index[i] = MCRT_NO_HIT;
                 for (uint32_t i = 0; i < MCRT_PACKET_WIDTH && k + i < count; ++i) {
                     const gpu::Triangle& t = triangles[first + k + i];
                     const gpu::float4* v[3] = {&t.p0, &t.p1, &t.p2};

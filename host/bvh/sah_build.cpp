@@ -21,12 +21,6 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 // Bounds of an empty root: inverted but finite, as kernels may assume no infinities.
 constexpr float kHuge = 1e30f;
 
-float uint_as_float(uint32_t u) {
-    float f;
-    std::memcpy(&f, &u, sizeof f);
-    return f;
-}
-
 // Four floats (x, y, z, unused w = 0) in a GCC/Clang vector: one SSE/NEON op per box update.
 typedef float V4 __attribute__((vector_size(16)));
 typedef int32_t V4i __attribute__((vector_size(16)));
@@ -116,17 +110,13 @@ struct Scratch {
 constexpr uint32_t kParallelMinTriangles = 65536;
 
 bool is_inner(const gpu::BvhNode& node) {
-    uint32_t count;
-    std::memcpy(&count, &node.hi.w, sizeof count);
-    return count == 0;
+    return gpu::as_uint(node.hi.w) == 0;
 }
 
 // Moves an inner node's child index by `offset`; leaves index triangles and stay.
 gpu::BvhNode shifted(gpu::BvhNode node, uint32_t offset) {
     if (is_inner(node)) {
-        uint32_t first;
-        std::memcpy(&first, &node.lo.w, sizeof first);
-        node.lo.w = uint_as_float(first + offset);
+        node.lo.w = gpu::as_float(gpu::as_uint(node.lo.w) + offset);
     }
     return node;
 }
@@ -171,8 +161,8 @@ void set_box(gpu::BvhNode& node, const Bounds& box) {
 }
 
 void set_first_count(gpu::BvhNode& node, uint32_t first, uint32_t count) {
-    node.lo.w = uint_as_float(first);
-    node.hi.w = uint_as_float(count);
+    node.lo.w = gpu::as_float(first);
+    node.hi.w = gpu::as_float(count);
 }
 
 Bounds node_box(const gpu::BvhNode& node) {
@@ -442,10 +432,9 @@ std::vector<gpu::BvhNode> Builder::build_parallel(const Task& root, const gpu::B
             nodes[f] = shifted(sub[0], offset);
             for (size_t j = 1; j < sub.size(); ++j) nodes.push_back(shifted(sub[j], offset));
         } else if (is_inner(top[t])) {
-            uint32_t first;
-            std::memcpy(&first, &top[t].lo.w, sizeof first);
+            const uint32_t first = gpu::as_uint(top[t].lo.w);
             const uint32_t c = uint32_t(nodes.size());
-            nodes[f].lo.w = uint_as_float(c);
+            nodes[f].lo.w = gpu::as_float(c);
             nodes.push_back(top[first]);
             nodes.push_back(top[first + 1]);
             stack.push_back({first + 1, c + 1});
@@ -487,8 +476,8 @@ Bvh Builder::build() {
         const uint32_t t = ids_[i];
         const glm::vec3* p = &scene_.positions[3 * size_t(t)];
         gpu::Triangle& tri = bvh.triangles[i];
-        tri.p0 = {p[0].x, p[0].y, p[0].z, uint_as_float(scene_.triangle_material[t])};
-        tri.p1 = {p[1].x, p[1].y, p[1].z, uint_as_float(t)};
+        tri.p0 = {p[0].x, p[0].y, p[0].z, gpu::as_float(scene_.triangle_material[t])};
+        tri.p1 = {p[1].x, p[1].y, p[1].z, gpu::as_float(t)};
         tri.p2 = {p[2].x, p[2].y, p[2].z, 0.0f};
     }
     fill_stats(bvh, depth);
@@ -517,8 +506,7 @@ void Builder::fill_stats(Bvh& bvh, int depth) const {
     const double root_area = node_box(bvh.nodes[0]).area();
     double cost = 0.0;
     for (const gpu::BvhNode& node : bvh.nodes) {
-        uint32_t count;
-        std::memcpy(&count, &node.hi.w, sizeof count);
+        const uint32_t count = gpu::as_uint(node.hi.w);
         // A flat root (a point or a segment) is entered by every ray that enters any node.
         const double ratio = root_area > 0.0 ? node_box(node).area() / root_area : 1.0;
         // Only the root of an empty scene is a leaf of count 0.

@@ -29,11 +29,25 @@ static std::string read_kernel_file(const std::string& name) {
     return it->second;
 }
 
+// `name` as a C string literal for #line.
+static std::string quoted(const std::string& name) {
+    std::string q = "\"";
+    for (char c : name) {
+        if (c == '"' || c == '\\') q += '\\';
+        q += c == '\n' ? ' ' : c;
+    }
+    return q + "\"";
+}
+
 // Expands `#include "name"` lines; a file already expanded is skipped the second time.
-static void expand(const std::string& name, std::set<std::string>& seen, std::string& out) {
+static void expand(const std::string& name, const KernelReplacements& replacements,
+                   std::set<std::string>& seen, std::string& out) {
     if (!seen.insert(name).second) return;
-    std::istringstream in(read_kernel_file(name));
-    out += "#line 1 \"" + name + "\"\n";
+    auto replaced = replacements.find(name);
+    const std::string shown = replaced != replacements.end() ? replaced->second.name : name;
+    std::istringstream in(replaced != replacements.end() ? replaced->second.text
+                                                         : read_kernel_file(name));
+    out += "#line 1 " + quoted(shown) + "\n";
     std::string line;
     int line_number = 0;
     while (std::getline(in, line)) {
@@ -43,8 +57,8 @@ static void expand(const std::string& name, std::set<std::string>& seen, std::st
             size_t open = line.find('"', start);
             size_t close = open == std::string::npos ? open : line.find('"', open + 1);
             if (close != std::string::npos) {
-                expand(line.substr(open + 1, close - open - 1), seen, out);
-                out += "#line " + std::to_string(line_number + 1) + " \"" + name + "\"\n";
+                expand(line.substr(open + 1, close - open - 1), replacements, seen, out);
+                out += "#line " + std::to_string(line_number + 1) + " " + quoted(shown) + "\n";
                 continue;
             }
         }
@@ -53,10 +67,10 @@ static void expand(const std::string& name, std::set<std::string>& seen, std::st
     }
 }
 
-std::string kernel_source(const std::string& file) {
+std::string kernel_source(const std::string& file, const KernelReplacements& replacements) {
     std::set<std::string> seen;
     std::string out;
-    expand(file, seen, out);
+    expand(file, replacements, seen, out);
     return out;
 }
 
@@ -77,13 +91,14 @@ cl::Program build_program(const cl::Context& context, const cl::Device& device,
 }
 
 cl::Program cached_program(const DeviceContext& device, const std::string& file,
-                           const std::string& options) {
+                           const std::string& options, const KernelReplacements& replacements) {
     // Keyed by the context handle: the cached program holds a reference to its context, so the
     // handle cannot be freed and reused while the entry exists.
     using Key = std::tuple<cl_context, cl_device_id, std::string, std::string>;
     static std::mutex mutex;
     static std::map<Key, cl::Program> programs;
-    Key key{device.context(), device.info.device(), file, options};
+    const std::string source = kernel_source(file, replacements);
+    Key key{device.context(), device.info.device(), source, options};
     std::lock_guard<std::mutex> lock(mutex);
     auto it = programs.find(key);
     if (it != programs.end()) return it->second;
@@ -95,9 +110,9 @@ cl::Program cached_program(const DeviceContext& device, const std::string& file,
                              std::string::npos &&
                          !(pocl_cache && std::string(pocl_cache) == "0");
     cl::Program program =
-        driver_caches ? build_program(device.context, device.info.device, kernel_source(file), options)
+        driver_caches ? build_program(device.context, device.info.device, source, options)
                       : build_program_cached(device.context, device.info.device, device.info,
-                                             kernel_source(file), options);
+                                             source, options);
     programs.emplace(key, program);
     return program;
 }

@@ -1,6 +1,7 @@
 // OpenCL program sources (embedded or from disk) and their compilation.
 #pragma once
 
+#include <map>
 #include <string>
 
 #include <CL/opencl.hpp>
@@ -9,11 +10,19 @@
 
 namespace mcrt {
 
+// A kernel file's text supplied by the caller instead of the embedded one (a user's estimator):
+// `name` is what build errors call it (#line markers), e.g. the path the user gave.
+struct KernelFile {
+    std::string name;
+    std::string text;
+};
+using KernelReplacements = std::map<std::string, KernelFile>;  // by the file name #include uses
+
 // Source of kernels/<file> with every #include "..." expanded once (include guards are not
 // needed) and #line markers, so build errors name the right file and line. The files are those
-// embedded at build time, or those of $MCRT_KERNEL_DIR when set (development override).
-// Throws RuntimeError when a file is missing.
-std::string kernel_source(const std::string& file);
+// embedded at build time, or those of $MCRT_KERNEL_DIR when set (development override), except
+// those in `replacements`. Throws RuntimeError when a file is missing.
+std::string kernel_source(const std::string& file, const KernelReplacements& replacements = {});
 
 // Builds source for the context's device with the options. A failing build throws
 // RuntimeError carrying the device name and the build log.
@@ -24,7 +33,7 @@ cl::Program build_program(const cl::Context& context, const cl::Device& device,
 // every specialised variant (-D options) is compiled once, however many renders use it.
 // Thread-safe.
 cl::Program cached_program(const DeviceContext& device, const std::string& file,
-                           const std::string& options);
+                           const std::string& options, const KernelReplacements& replacements = {});
 
 // A kernel by name, throwing ClError.
 cl::Kernel make_kernel(const cl::Program& program, const char* name);

@@ -8,6 +8,8 @@
 #include <iostream>
 
 #include "cl/cl_error.h"
+#include "cli/device_select.h"
+#include "cli/messages.h"
 #include "cl/program.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
@@ -39,10 +41,6 @@ const char* kColumnsHelp =
     "  rmse       sqrt(mean over the R repeats of (estimate_r - pi)^2)\n"
     "Output is a pure function of the options: random numbers are hashed from\n"
     "(seed, repeat, sample, dimension) (pcg4d), sums are taken in double in sample order.\n";
-
-void print_warning(const std::string& message) {
-    std::cerr << "mcrt: warning: " << message << std::endl;
-}
 
 void check_options(const IntegrateOptions& o) {
     if (o.estimators.empty()) throw InputError("--estimators: expected at least one estimator");
@@ -108,16 +106,6 @@ IntegrateRow summarize(const std::string& estimator, int64_t n, const std::vecto
     row.std_error = std::sqrt(spread / (r - 1));
     row.rmse = std::sqrt(squared_error / r);
     return row;
-}
-
-DeviceInfo chosen_device(int64_t index) {
-    std::vector<DeviceInfo> all = enumerate_devices(print_warning);
-    if (all.empty())
-        throw RuntimeError("no OpenCL device found (is an ICD such as PoCL installed?)");
-    if (index >= int64_t(all.size()))
-        throw InputError("--device " + std::to_string(index) + ": no such device (" +
-                         std::to_string(all.size()) + " found; see `mcrt devices`)");
-    return all[size_t(index)];
 }
 
 }  // namespace
@@ -186,7 +174,7 @@ int run_integrate(const IntegrateOptions& o) {
         if (!dir.empty() && !std::filesystem::is_directory(dir))
             throw InputError("--out " + o.out + ": directory " + dir.string() + " does not exist");
     }
-    DeviceContext device(chosen_device(o.device));
+    DeviceContext device(select_device(o.device, print_warning));
     std::string csv = integrate_csv(integrate_cosine_hemisphere(device, o));
     if (o.out.empty()) {
         std::cout << csv << std::flush;

@@ -8,11 +8,6 @@
 
 namespace mcrt {
 
-static float uint_bits(uint32_t u) {
-    float f;
-    std::memcpy(&f, &u, sizeof f);
-    return f;
-}
 
 static gpu::float4 to_float4(const glm::vec3& v, float w = 0.0f) { return {v.x, v.y, v.z, w}; }
 
@@ -52,7 +47,7 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
         const glm::vec3* p = &scene.positions[3 * size_t(e.triangle)];
         gpu::Light light{};
         light.p0 = to_float4(p[0], e.area);
-        light.p1 = to_float4(p[1], uint_bits(m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u));
+        light.p1 = to_float4(p[1], gpu::as_float(m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u));
         light.p2 = to_float4(p[2]);
         light.Le = to_float4(m.emission);
         data.lights.push_back(light);
@@ -66,9 +61,8 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
     for (size_t p = 0; p < bvh.packets.size(); ++p) {
         for (int lane = 0; lane < MCRT_PACKET_WIDTH; ++lane) {
             const uint32_t leaf = bvh.packets[p].index[lane];
-            if (leaf == 0xffffffffu) continue;
-            uint32_t scene_triangle;
-            std::memcpy(&scene_triangle, &bvh.triangles[leaf].p1.w, sizeof scene_triangle);
+            if (leaf == MCRT_NO_HIT) continue;
+            const uint32_t scene_triangle = gpu::as_uint(bvh.triangles[leaf].p1.w);
             gpu::TriangleInfo& info = data.triangle_info[p * MCRT_PACKET_WIDTH + size_t(lane)];
             info.material = scene.triangle_material[scene_triangle];
             info.light = light_of_triangle[scene_triangle];

@@ -14,8 +14,6 @@
 
 namespace mcrt {
 
-enum class LightSelect { Uniform, Power, Alias };
-
 struct GpuSceneData {
     std::vector<gpu::Bvh4Node> nodes;  // 4-wide, as the kernels traverse it
     std::vector<gpu::TrianglePacket> packets;  // the leaves' triangles, four per ray test

@@ -15,24 +15,21 @@
 
 namespace mcrt {
 
-enum class SamplerKind { Independent, Stratified, Sobol };
-enum class MisHeuristic { Balance, Power };
-
+// Variants are named as in the tables of render/variants.h.
 struct RenderSettings {
     int width = 512, height = 512;
     uint32_t spp = 16;
-    std::string estimator = "light-area";  // a name of kEstimators
-    LightSelect light_select = LightSelect::Power;
-    SamplerKind sampler = SamplerKind::Independent;
-    MisHeuristic mis_heuristic = MisHeuristic::Balance;
+    std::string estimator = "light-area";  // a row of kEstimatorVariants; unused with a file
+    std::string estimator_file;    // a user's estimator (--estimator-file), "" for none
+    std::string estimator_source;  // its text (read_estimator_file)
+    std::string light_select = "power";    // kLightSelectVariants
+    std::string sampler = "independent";   // kSamplerVariants
+    std::string mis_heuristic = "balance"; // kMisHeuristicVariants
     glm::vec3 sky{1.0f};        // ambient estimators: uniform sky radiance
     float ao_distance = 0.0f;   // ambient estimators: occlusion range, 0 = unbounded
     uint32_t seed = 0;
     uint32_t batch = 0;  // samples per pixel per launch; 0 chooses; rounded up to whole chunks
 };
-
-// The estimators of DESIGN.md, by their command-line names.
-extern const std::vector<std::string> kEstimators;
 
 struct DeviceReport {
     std::string name;
@@ -63,10 +60,6 @@ struct RenderControl {
     double time_limit = 0;
     const volatile std::sig_atomic_t* interrupted = nullptr;
 };
-
-// The -D options of the render program for these settings (throws InputError for an unknown
-// estimator).
-std::string render_program_options(const RenderSettings& settings);
 
 // Renders on every device at once: work is handed out dynamically, each device's launches sized
 // to take about 150 ms; a device that fails is retired with a warning and its work redone on the

@@ -38,8 +38,6 @@ public:
     uint32_t samples_in_chunk(uint32_t chunk) const;
 
 private:
-    uint64_t samples_of(const WorkItem& item) const;
-
     const uint32_t pixels_, spp_, chunks_;
     mutable std::mutex mutex_;
     std::condition_variable changed_;

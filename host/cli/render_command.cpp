@@ -1,0 +1,229 @@
+#include "cli/render_command.h"
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "bvh/bvh.h"
+#include "cli/device_select.h"
+#include "cli/messages.h"
+#include "cli/progress.h"
+#include "cli/stats_json.h"
+#include "cli/validators.h"
+#include "common/atomic_file.h"
+#include "common/error.h"
+#include "image/image.h"
+#include "render/render_program.h"
+#include "render/renderer.h"
+#include "render/variants.h"
+#include "scene/gltf_import.h"
+
+namespace mcrt {
+namespace {
+
+volatile std::sig_atomic_t g_interrupted = 0;
+
+extern "C" void on_interrupt(int) { g_interrupted = 1; }
+
+// While a render runs, SIGINT and SIGTERM ask it to stop and write the samples done so far;
+// a second signal ends the process at once.
+struct InterruptGuard {
+    InterruptGuard() {
+        g_interrupted = 0;
+        struct sigaction action {};
+        action.sa_handler = on_interrupt;
+        action.sa_flags = SA_RESETHAND;
+        sigemptyset(&action.sa_mask);
+        sigaction(SIGINT, &action, &old_int);
+        sigaction(SIGTERM, &action, &old_term);
+    }
+    ~InterruptGuard() {
+        sigaction(SIGINT, &old_int, nullptr);
+        sigaction(SIGTERM, &old_term, nullptr);
+    }
+    struct sigaction old_int {}, old_term {};
+};
+
+// An output's directory must exist before rendering starts, not after.
+void check_output_path(const std::string& path, const char* option) {
+    if (path.empty()) return;
+    std::filesystem::path dir = std::filesystem::path(path).parent_path();
+    if (!dir.empty() && !std::filesystem::is_directory(dir))
+        throw InputError(std::string(option) + " " + path + ": directory " + dir.string() +
+                         " does not exist");
+}
+
+glm::vec3 parse_sky(const std::string& text) {
+    std::vector<float> v;
+    std::stringstream in(text);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        try {
+            size_t used = 0;
+            float x = std::stof(item, &used);
+            if (used != item.size() || !std::isfinite(x) || x < 0) throw std::invalid_argument(item);
+            v.push_back(x);
+        } catch (const std::exception&) {
+            throw InputError("--sky " + text + ": expected R,G,B or one value, finite and >= 0");
+        }
+    }
+    if (v.size() == 1) return glm::vec3(v[0]);
+    if (v.size() == 3) return glm::vec3(v[0], v[1], v[2]);
+    throw InputError("--sky " + text + ": expected R,G,B or one value");
+}
+
+// One line per row: "name  description", for --help.
+template <typename Table>
+std::string help_list(const char* what, const Table& table) {
+    std::string text = what;
+    for (const auto& row : table) text += std::string("\n  ") + row.name + ": " + row.description;
+    return text;
+}
+
+RenderSettings settings_of(const RenderOptions& o) {
+    RenderSettings settings;
+    settings.width = o.width;
+    settings.height = o.height;
+    settings.spp = o.spp;
+    settings.estimator = o.estimator;
+    if (!o.estimator_file.empty()) {
+        settings.estimator_file = o.estimator_file;
+        settings.estimator_source = read_estimator_file(o.estimator_file);
+    }
+    settings.light_select = o.light_select;
+    settings.sampler = o.sampler;
+    settings.mis_heuristic = o.mis_heuristic;
+    settings.sky = parse_sky(o.sky);
+    settings.ao_distance = o.ao_distance;
+    settings.seed = o.seed;
+    settings.batch = o.batch;
+    render_program_options(settings);  // rejects what is not supported before any work
+    return settings;
+}
+
+}  // namespace
+
+CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
+    CLI::App* cmd = app.add_subcommand("render", "render a glTF scene to EXR");
+    cmd->add_option("scene", o.scene, "glTF scene (.gltf or .glb)")->required();
+    cmd->add_option("--out", o.out, "output EXR")->required();
+    cmd->add_option("--png", o.png, "also write an sRGB PNG");
+    cmd->add_option("--width", o.width, "image width")->capture_default_str()->check(CLI::Range(1, 16384));
+    cmd->add_option("--height", o.height, "image height")->capture_default_str()->check(CLI::Range(1, 16384));
+    cmd->add_option("--spp", o.spp, "samples per pixel")->capture_default_str()->check(CLI::Range(1u, 1u << 24));
+    CLI::Option* estimator =
+        cmd->add_option("--estimator", o.estimator, help_list("estimator:", kEstimatorVariants))
+            ->capture_default_str()
+            ->check(CLI::IsMember(variant_names(kEstimatorVariants)));
+    cmd->add_option("--estimator-file", o.estimator_file,
+                    "a user's estimator: an OpenCL C file defining float3 estimate(...) against the "
+                    "kernel API of docs/ESTIMATORS.md")
+        ->excludes(estimator);
+    cmd->add_option("--light-select", o.light_select, help_list("light selection:", kLightSelectVariants))
+        ->capture_default_str()
+        ->check(CLI::IsMember(variant_names(kLightSelectVariants)));
+    cmd->add_option("--sampler", o.sampler, help_list("sample generator:", kSamplerVariants))
+        ->capture_default_str()
+        ->check(CLI::IsMember(variant_names(kSamplerVariants)));
+    cmd->add_option("--mis-heuristic", o.mis_heuristic,
+                    help_list("MIS weights (estimators that use them):", kMisHeuristicVariants))
+        ->capture_default_str()
+        ->check(CLI::IsMember(variant_names(kMisHeuristicVariants)));
+    cmd->add_option("--seed", o.seed, "random seed")->capture_default_str();
+    cmd->add_option("--sky", o.sky, "sky radiance R,G,B (ambient estimators)")->capture_default_str();
+    cmd->add_option("--ao-distance", o.ao_distance, "ambient occlusion distance, 0 = unbounded")->capture_default_str()
+        ->check(kFinite)->check(CLI::Range(0.0f, 3.4e38f));
+    cmd->add_option("--camera", o.camera, "camera index in the scene")->check(CLI::Range(0, 1 << 30));
+    cmd->add_option("--device", o.devices, "device index, cpu, gpu or all (repeatable)");
+    cmd->add_option("--batch", o.batch, "samples per pixel per launch (0 chooses)")->capture_default_str()
+        ->check(CLI::Range(0u, 1u << 24));
+    cmd->add_option("--stats", o.stats, "write statistics as JSON");
+    cmd->add_option("--time-limit", o.time_limit, "stop after this many seconds")
+        ->check(kFinite)->check(CLI::Range(0.0, 1e9));
+    cmd->add_option("--exposure", o.exposure, "PNG exposure in stops")->capture_default_str()->check(kFinite)->check(CLI::Range(-64.0f, 64.0f));
+    cmd->add_flag("--quiet", o.quiet, "no progress output");
+    return cmd;
+}
+
+int run_render(const RenderOptions& o) {
+    auto start = std::chrono::steady_clock::now();
+    if (o.width * int64_t(o.height) * o.spp >= (int64_t(1) << 40))
+        throw InputError("--width × --height × --spp is too large");
+    check_output_path(o.out, "--out");
+    check_output_path(o.png, "--png");
+    check_output_path(o.stats, "--stats");
+    RenderSettings settings = settings_of(o);
+
+    Scene scene = load_gltf(o.scene, print_warning);
+    if (scene.triangle_count() == 0) print_warning(o.scene + ": the scene has no triangles");
+    unsigned uses = o.estimator_file.empty() ? estimator_variant(o.estimator).uses
+                                             : kUserEstimatorUses;
+    if ((uses & kUsesLights) && collect_emitters(scene).empty())
+        print_warning(o.scene + ": no emissive triangles: direct lighting is black");
+    Camera camera;
+    if (o.camera >= 0) {
+        if (size_t(o.camera) >= scene.cameras.size())
+            throw InputError("--camera " + std::to_string(o.camera) + ": " + o.scene + " has " +
+                             std::to_string(scene.cameras.size()) + " perspective camera(s)");
+        camera = scene.cameras[size_t(o.camera)];
+    } else {
+        camera = scene.cameras.empty() ? bench_camera(scene) : scene.cameras.front();
+    }
+
+    std::vector<DeviceInfo> devices = select_devices(o.devices, print_warning);
+    std::vector<std::unique_ptr<DeviceContext>> contexts;
+    std::vector<const DeviceContext*> device_list;
+    for (const DeviceInfo& d : devices) {
+        contexts.push_back(std::make_unique<DeviceContext>(d));
+        device_list.push_back(contexts.back().get());
+    }
+
+    Bvh bvh = build_bvh(scene);
+    GpuSceneData gpu_scene = make_gpu_scene(scene, bvh, camera, o.width, o.height);
+
+    RenderControl control;
+    control.time_limit = o.time_limit;
+    control.interrupted = &g_interrupted;
+    InterruptGuard interrupt_guard;  // SIGINT / SIGTERM: stop and write what is done
+    ProgressBar bar(!o.quiet, uint64_t(o.width) * o.height);
+    RenderResult result = render(
+        device_list, gpu_scene, settings,
+        [&](uint32_t done, uint32_t total, const std::vector<DeviceReport>& d) {
+            bar.update(done, total, d);
+        },
+        control, print_warning);
+    bar.finish();
+    if (!result.stopped_by.empty())
+        print_warning("stopped by " + result.stopped_by + " after " + std::to_string(result.spp) +
+                      " of " + std::to_string(o.spp) + " samples per pixel; writing those");
+
+    std::map<std::string, std::string> attributes = {
+        {"mcrt.scene", o.scene},
+        {"mcrt.estimator", o.estimator_file.empty() ? o.estimator : o.estimator_file},
+        {"mcrt.light_select", o.light_select},
+        {"mcrt.sampler", o.sampler},
+        {"mcrt.seed", std::to_string(o.seed)},
+        {"mcrt.mis_heuristic", o.mis_heuristic}};
+    write_exr(o.out, result.image, attributes);
+    if (!o.png.empty()) write_png(o.png, result.image, o.exposure);
+
+    double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!o.stats.empty()) {
+        nlohmann::json j = render_stats_json({o, settings, scene, bvh, gpu_scene, result, total});
+        write_atomically(o.stats, [&](const std::string& tmp) {
+            std::ofstream out(tmp);
+            out << j.dump(2) << "\n";
+            if (!out) throw RuntimeError(o.stats + ": cannot write");
+        });
+    }
+    if (!o.quiet)
+        std::cerr << "mcrt: wrote " << o.out << " (" << o.width << "x" << o.height << ", "
+                  << result.spp << " spp, " << result.seconds_render << " s on the device)" << std::endl;
+    return 0;
+}
+
+}  // namespace mcrt

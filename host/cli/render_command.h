@@ -1,0 +1,35 @@
+// `mcrt render`: its options, their validation, and the render that writes EXR, PNG and stats.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+namespace mcrt {
+
+struct RenderOptions {
+    std::string scene, out, png, stats;
+    int width = 512, height = 512;
+    uint32_t spp = 16;
+    std::string estimator = "light-area", estimator_file;
+    std::string light_select = "power", sampler = "independent", mis_heuristic = "balance";
+    uint32_t seed = 0;
+    std::string sky = "1";
+    float ao_distance = 0.0f;
+    int camera = -1;
+    std::vector<std::string> devices;
+    uint32_t batch = 0;
+    double time_limit = 0.0;
+    float exposure = 0.0f;
+    bool quiet = false;
+};
+
+// Adds the `render` subcommand, its options filling `o`.
+CLI::App* add_render_command(CLI::App& app, RenderOptions& o);
+
+// Runs it; returns the exit status, throws InputError / RuntimeError (run_cli prints them).
+int run_render(const RenderOptions& o);
+
+}  // namespace mcrt

@@ -1,0 +1,69 @@
+#include "cli/stats_json.h"
+
+#include <array>
+
+#include "render/variants.h"
+
+namespace mcrt {
+
+nlohmann::json render_stats_json(const RenderStatsInput& in) {
+    const RenderOptions& o = in.options;
+    const RenderResult& result = in.result;
+    const Bvh& bvh = in.bvh;
+    uint64_t samples = uint64_t(o.width) * o.height * result.spp;
+    unsigned uses = o.estimator_file.empty() ? estimator_variant(o.estimator).uses
+                                             : kUserEstimatorUses;
+    nlohmann::json j = {
+        {"scene", o.scene},
+        {"width", o.width},
+        {"height", o.height},
+        {"spp", result.spp},
+        {"spp_requested", o.spp},
+        {"stopped_by", result.stopped_by},
+        {"estimator", o.estimator_file.empty() ? o.estimator : o.estimator_file},
+        {"estimator_file", o.estimator_file},
+        {"estimator_uses", uses_names(uses)},
+        {"light_select", o.light_select},
+        {"sampler", o.sampler},
+        {"seed", o.seed},
+        {"mis_heuristic", o.mis_heuristic},
+        {"sky", {in.settings.sky.r, in.settings.sky.g, in.settings.sky.b}},
+        {"ao_distance", o.ao_distance},
+        {"seconds_total", in.seconds_total},
+        {"seconds_render", result.seconds_render},
+        {"seconds_kernel_build", result.seconds_build},
+        {"seconds_bvh_build", bvh.stats.build_seconds},
+        {"samples_per_second", result.seconds_render > 0 ? samples / result.seconds_render : 0.0},
+        {"rays", result.rays},
+        {"rays_per_second", result.seconds_render > 0 ? result.rays / result.seconds_render : 0.0},
+        {"nan_samples", result.nan_samples},
+        {"triangles", in.scene.triangle_count()},
+        {"lights", in.gpu_scene.lights.size()},
+        // The 4-wide tree the kernels traverse; the binary SAH tree it collapses as binary_*.
+        {"bvh", {{"nodes", bvh.nodes4.size()}, {"packets", bvh.stats.packets},
+                 {"sah_cost", bvh.stats.sah_cost4}, {"depth", bvh.stats.depth4},
+                 {"bytes", bvh.stats.bytes}, {"binary_nodes", bvh.nodes.size()},
+                 {"binary_sah_cost", bvh.stats.sah_cost}, {"binary_depth", bvh.stats.depth},
+                 {"build_seconds", bvh.stats.build_seconds}}},
+    };
+    // Image-wide means, so that scripts can compare renders without reading EXR.
+    std::array<double, 3> mean{}, mean_variance{};
+    size_t pixels = size_t(o.width) * o.height;
+    for (size_t p = 0; p < pixels; ++p)
+        for (int c = 0; c < 3; ++c) {
+            mean[c] += result.image.rgb[3 * p + c] / double(pixels);
+            mean_variance[c] += result.image.variance[3 * p + c] / double(pixels);
+        }
+    j["image_mean"] = mean;
+    j["image_mean_variance"] = mean_variance;
+    nlohmann::json devices = nlohmann::json::array();
+    for (const DeviceReport& d : result.devices)
+        devices.push_back({{"name", d.name}, {"index", d.index}, {"samples", d.samples},
+                           {"batches", d.batches}, {"seconds_busy", d.seconds_busy},
+                           {"retired", d.retired},
+                           {"samples_per_second", d.seconds_busy > 0 ? d.samples / d.seconds_busy : 0.0}});
+    j["devices"] = devices;
+    return j;
+}
+
+}  // namespace mcrt

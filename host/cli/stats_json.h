@@ -1,0 +1,26 @@
+// The stats JSON of `mcrt render --stats` (DESIGN.md "Outputs"), plus BVH and timing details.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "bvh/bvh.h"
+#include "cli/render_command.h"
+#include "render/gpu_scene.h"
+#include "render/renderer.h"
+#include "scene/scene.h"
+
+namespace mcrt {
+
+struct RenderStatsInput {
+    const RenderOptions& options;
+    const RenderSettings& settings;
+    const Scene& scene;
+    const Bvh& bvh;
+    const GpuSceneData& gpu_scene;
+    const RenderResult& result;
+    double seconds_total = 0;
+};
+
+nlohmann::json render_stats_json(const RenderStatsInput& in);
+
+}  // namespace mcrt

@@ -1,0 +1,173 @@
+#include "render/device_worker.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <thread>
+
+#include "cl/cl_error.h"
+#include "cl/program.h"
+#include "common/error.h"
+#include "render/render_program.h"
+
+namespace mcrt {
+
+namespace {
+
+double event_seconds(const cl::Event& event) {
+    cl_ulong start = 0, end = 0;
+    CL_CHECK(event.getProfilingInfo(CL_PROFILING_COMMAND_START, &start));
+    CL_CHECK(event.getProfilingInfo(CL_PROFILING_COMMAND_END, &end));
+    return double(end - start) * 1e-9;
+}
+
+cl::Buffer device_buffer(const DeviceContext& device, cl_mem_flags flags, size_t bytes,
+                         const char* what) {
+    cl_int status = CL_SUCCESS;
+    cl::Buffer buffer(device.context, flags, bytes, nullptr, &status);
+    CL_CHECK_STATUS(status, (std::string("clCreateBuffer(") + what + ")").c_str());
+    return buffer;
+}
+
+// "D:V" from an environment variable: device index D and a value, for testing and simulation.
+bool device_switch(const char* name, int device_index, double* value) {
+    const char* text = std::getenv(name);
+    if (!text) return false;
+    int d = -1;
+    double v = 0;
+    if (std::sscanf(text, "%d:%lf", &d, &v) != 2 || d != device_index) return false;
+    *value = v;
+    return true;
+}
+
+constexpr size_t kGroupSize = 64;
+
+uint64_t round_up(uint64_t n, uint64_t m) { return (n + m - 1) / m * m; }
+
+// A launch should take about this long: long enough to hide launch overhead, short enough to
+// balance devices and to stop promptly.
+constexpr double kTargetLaunchSeconds = 0.15;
+
+}  // namespace
+
+void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene, const cl::Buffer& samples) {
+    CL_CHECK(render.setArg(gpu::RENDER_ARG_NODES, scene.nodes));
+    CL_CHECK(render.setArg(gpu::RENDER_ARG_PACKETS, scene.packets));
+    CL_CHECK(render.setArg(gpu::RENDER_ARG_TRIANGLE_INFO, scene.triangle_info));
+    CL_CHECK(render.setArg(gpu::RENDER_ARG_MATERIALS, scene.materials));
+    CL_CHECK(render.setArg(gpu::RENDER_ARG_LIGHTS, scene.lights));
+    CL_CHECK(render.setArg(gpu::RENDER_ARG_LIGHT_CDF, scene.light_cdf));
+    CL_CHECK(render.setArg(gpu::RENDER_ARG_LIGHT_ALIAS, scene.light_alias));
+    CL_CHECK(render.setArg(gpu::RENDER_ARG_CAMERA, scene.camera));
+    CL_CHECK(render.setArg(gpu::RENDER_ARG_SAMPLES, samples));
+}
+
+DeviceWorker::DeviceWorker(const DeviceContext& device, const GpuSceneData& scene,
+                           const RenderSettings& settings, uint64_t fixed_batch_samples)
+    : device_(device), settings_(settings), fixed_batch_(fixed_batch_samples) {
+    report.name = device.info.name;
+    report.index = device.info.index;
+    double v;
+    if (device_switch("MCRT_FAULT_INJECT", device.info.index, &v)) fail_at_launch_ = uint64_t(v);
+    if (device_switch("MCRT_SLOW_DEVICE", device.info.index, &v)) slow_factor_ = std::max(1.0, v);
+
+    cl::Program program = render_program(device, settings);
+    render_ = make_kernel(program, "render");
+    reduce_ = make_kernel(program, "reduce_chunks");
+    buffers_ = std::make_unique<GpuSceneBuffers>(device, scene);
+
+    // Batch buffers: at most 2^22 samples (64 MiB; a 150 ms launch needs far fewer on today's
+    // devices) or a quarter of an allocation, whichever is less.
+    max_samples_ = std::min<uint64_t>(uint64_t(1) << 22,
+                                      device.info.max_allocation / 4 / sizeof(gpu::float4));
+    if (fixed_batch_ > 0) max_samples_ = std::max(max_samples_, fixed_batch_);
+    uint64_t needed = buffers_->bytes + max_samples_ * sizeof(gpu::float4) * 3;
+    if (needed > device.info.global_memory)
+        throw RuntimeError("device '" + device.info.name + "' has " +
+                           std::to_string(device.info.global_memory) +
+                           " bytes of memory; the scene and batch buffers need " +
+                           std::to_string(needed));
+    samples_ = device_buffer(device, CL_MEM_READ_WRITE,
+                             round_up(max_samples_, kGroupSize) * sizeof(gpu::float4), "samples");
+    // Up to one sum per sample, when spp < one chunk.
+    sums_ = device_buffer(device, CL_MEM_WRITE_ONLY, max_samples_ * sizeof(gpu::float4), "sums");
+    sums_sq_ = device_buffer(device, CL_MEM_WRITE_ONLY, max_samples_ * sizeof(gpu::float4), "sums");
+
+    bind_render_arguments(render_, *buffers_, samples_);
+    CL_CHECK(reduce_.setArg(0, samples_));
+    CL_CHECK(reduce_.setArg(3, sums_));
+    CL_CHECK(reduce_.setArg(4, sums_sq_));
+}
+
+uint64_t DeviceWorker::target_samples() const {
+    if (fixed_batch_ > 0) return fixed_batch_;
+    if (report.seconds_busy <= 0) return 1024;  // the probe failed to measure anything
+    double rate = double(report.samples) / (report.seconds_busy * slow_factor_);
+    return std::clamp<uint64_t>(uint64_t(rate * kTargetLaunchSeconds), 1024, max_samples_);
+}
+
+BatchResult DeviceWorker::run(const WorkItem& item) {
+    const uint32_t sample_begin = item.chunk_begin * MCRT_SAMPLES_PER_CHUNK;
+    const uint32_t sample_end =
+        std::min<uint32_t>(item.chunk_end * MCRT_SAMPLES_PER_CHUNK, settings_.spp);
+    const cl_uint n = sample_end - sample_begin;
+    const uint64_t samples = uint64_t(item.pixel_count()) * n;
+    if (samples > max_samples_)
+        throw RuntimeError("batch of " + std::to_string(samples) + " samples exceeds the " +
+                           std::to_string(max_samples_) + " the buffers of '" + report.name +
+                           "' hold");
+    if (++launches_ == fail_at_launch_)
+        throw ClError("clEnqueueNDRangeKernel (injected by MCRT_FAULT_INJECT)",
+                      CL_OUT_OF_RESOURCES, __FILE__, __LINE__);
+
+    gpu::RenderParams params{};
+    params.sky = {settings_.sky.r, settings_.sky.g, settings_.sky.b, 0.0f};
+    params.ao_distance = settings_.ao_distance;
+    params.width = uint32_t(settings_.width);
+    params.height = uint32_t(settings_.height);
+    params.seed = settings_.seed;
+    params.spp = settings_.spp;
+    params.light_count = buffers_->light_count;
+    params.pixel_begin = item.pixel_begin;
+    params.pixel_end = item.pixel_end;
+    params.sample_begin = sample_begin;
+    params.batch_samples = n;
+    CL_CHECK(render_.setArg(gpu::RENDER_ARG_PARAMS, sizeof params, &params));
+    const cl_uint chunks = item.chunk_count();
+    CL_CHECK(reduce_.setArg(1, n));
+    CL_CHECK(reduce_.setArg(2, cl_uint(item.pixel_count())));
+
+    cl::Event render_done, reduce_done;
+    // A fixed work-group size: PoCL specialises a kernel per local size, and a NULL local size
+    // lets it pick a new one for each global size (a compile per launch).
+    CL_CHECK(device_.queue.enqueueNDRangeKernel(render_, cl::NullRange,
+                                                cl::NDRange(round_up(samples, kGroupSize)),
+                                                cl::NDRange(kGroupSize), nullptr, &render_done));
+    CL_CHECK(device_.queue.enqueueNDRangeKernel(
+        reduce_, cl::NullRange,
+        cl::NDRange(round_up(uint64_t(item.pixel_count()) * chunks, kGroupSize)),
+        cl::NDRange(kGroupSize), nullptr, &reduce_done));
+    BatchResult result;
+    result.item = item;
+    result.sums.resize(size_t(item.pixel_count()) * chunks);
+    result.sums_sq.resize(result.sums.size());
+    size_t bytes = result.sums.size() * sizeof(gpu::float4);
+    CL_CHECK(device_.queue.enqueueReadBuffer(sums_, CL_FALSE, 0, bytes, result.sums.data()));
+    CL_CHECK(device_.queue.enqueueReadBuffer(sums_sq_, CL_TRUE, 0, bytes, result.sums_sq.data()));
+    double busy = event_seconds(render_done) + event_seconds(reduce_done);
+    if (slow_factor_ > 1.0)  // simulate a slower device (MCRT_SLOW_DEVICE)
+        std::this_thread::sleep_for(std::chrono::duration<double>(busy * (slow_factor_ - 1.0)));
+    // Counted into the report by commit_report(), under the lock the progress reads it with.
+    pending_busy_ = busy;
+    pending_samples_ = samples;
+    return result;
+}
+
+void DeviceWorker::commit_report() {
+    report.seconds_busy += pending_busy_;
+    report.samples += pending_samples_;
+    report.batches += 1;
+}
+
+}  // namespace mcrt

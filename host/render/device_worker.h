@@ -1,0 +1,56 @@
+// One device's part of a render: its copy of the scene, its compiled render and reduction
+// kernels, its batch buffers and its measured speed (the scheduler is in renderer.cpp).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include <CL/opencl.hpp>
+
+#include "cl/device.h"
+#include "render/accumulator.h"
+#include "render/gpu_scene.h"
+#include "render/renderer.h"
+#include "render/work_queue.h"
+
+namespace mcrt {
+
+// Binds the render kernel's buffers in the order of RenderArgument (kernels/shared_types.h); the
+// per-launch RenderParams are set with each launch.
+void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene, const cl::Buffer& samples);
+
+class DeviceWorker {
+public:
+    // Builds the program, uploads the scene and allocates the batch buffers; throws RuntimeError
+    // when the device cannot hold them, InputError for a user's estimator that does not build.
+    // `fixed_batch_samples` > 0 makes every launch that many samples (--batch).
+    DeviceWorker(const DeviceContext& device, const GpuSceneData& scene,
+                 const RenderSettings& settings, uint64_t fixed_batch_samples);
+
+    // Samples the next launch should hold: a fixed --batch, else a probe, then what the
+    // measured speed does in about 150 ms.
+    uint64_t target_samples() const;
+
+    // Renders and reduces one work item; throws RuntimeError when the device fails.
+    BatchResult run(const WorkItem& item);
+
+    // Adds the last successful launch to the report; the caller holds the render's lock.
+    void commit_report();
+
+    DeviceReport report;
+
+private:
+    const DeviceContext& device_;
+    const RenderSettings& settings_;
+    uint64_t fixed_batch_;
+    uint64_t max_samples_ = 0;
+    uint64_t launches_ = 0, fail_at_launch_ = 0;
+    double slow_factor_ = 1.0;
+    double pending_busy_ = 0;
+    uint64_t pending_samples_ = 0;
+    cl::Kernel render_, reduce_;
+    std::unique_ptr<GpuSceneBuffers> buffers_;
+    cl::Buffer samples_, sums_, sums_sq_;
+};
+
+}  // namespace mcrt

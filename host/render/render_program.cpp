@@ -1,0 +1,87 @@
+#include "render/render_program.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "common/error.h"
+#include "render/renderer.h"
+#include "render/variants.h"
+
+namespace mcrt {
+
+std::string render_program_options(const RenderSettings& settings) {
+    std::string options = "-cl-std=CL1.2";
+    unsigned uses = kUserEstimatorUses;
+    if (settings.estimator_file.empty()) {
+        const EstimatorVariant& estimator = estimator_variant(settings.estimator);
+        options += std::string(" -D MCRT_ESTIMATE=") + estimator.function;
+        uses = estimator.uses;
+        if (uses & kUsesSky) options += " -D ESTIMATOR_USES_SKY";
+    } else {
+        options += std::string(" -D MCRT_ESTIMATE=") + kUserEstimatorFunction;
+    }
+    options += std::string(" -D ") +
+               option_variant(kLightSelectVariants, settings.light_select, "--light-select").macro;
+    options += std::string(" -D ") +
+               option_variant(kSamplerVariants, settings.sampler, "--sampler").macro;
+    const OptionVariant& heuristic =
+        option_variant(kMisHeuristicVariants, settings.mis_heuristic, "--mis-heuristic");
+    if ((uses & kUsesMisHeuristic) && heuristic.macro) options += std::string(" -D ") + heuristic.macro;
+    return options;
+}
+
+KernelReplacements render_program_replacements(const RenderSettings& settings) {
+    if (settings.estimator_file.empty()) return {};
+    return {{"user_estimator.cl", {settings.estimator_file, settings.estimator_source}}};
+}
+
+namespace {
+
+// The first line of the build log that reports an error in `file`, as "FILE:LINE: message"
+// (clang's "FILE:LINE:COLUMN: error: message"); "" when the log names none.
+std::string first_error_in(const std::string& log, const std::string& file) {
+    std::istringstream in(log);
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.compare(0, file.size() + 1, file + ":") != 0) continue;
+        size_t error = line.find("error:");
+        if (error == std::string::npos) continue;
+        size_t line_end = line.find(':', file.size() + 1);
+        std::string line_number = line.substr(file.size() + 1, line_end - file.size() - 1);
+        return file + ":" + line_number + ": " + line.substr(error);
+    }
+    return "";
+}
+
+}  // namespace
+
+cl::Program render_program(const DeviceContext& device, const RenderSettings& settings) {
+    try {
+        return cached_program(device, "render.cl", render_program_options(settings),
+                              render_program_replacements(settings));
+    } catch (const RuntimeError& e) {
+        if (settings.estimator_file.empty()) throw;
+        std::string what = e.what();
+        std::string error = first_error_in(what.substr(what.find('\n') + 1), settings.estimator_file);
+        if (error.empty()) throw;
+        throw InputError(error + " (--estimator-file; build log follows)\n" +
+                         what.substr(what.find('\n') + 1));
+    }
+}
+
+std::string read_estimator_file(const std::string& path) {
+    std::error_code ec;
+    auto status = std::filesystem::status(path, ec);
+    if (ec || !std::filesystem::exists(status))
+        throw InputError("--estimator-file " + path + ": no such file");
+    if (!std::filesystem::is_regular_file(status))
+        throw InputError("--estimator-file " + path + ": not a regular file");
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (!in) throw InputError("--estimator-file " + path + ": cannot read");
+    return text.str();
+}
+
+}  // namespace mcrt

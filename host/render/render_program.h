@@ -1,0 +1,30 @@
+// The render program of a render's settings: its -D options from the table of variants, a
+// user's estimator file in place of kernels/user_estimator.cl, and its build on one device.
+#pragma once
+
+#include <string>
+
+#include <CL/opencl.hpp>
+
+#include "cl/device.h"
+#include "cl/program.h"
+
+namespace mcrt {
+
+struct RenderSettings;
+
+// The -D options of the render program (throws InputError for a name no table has).
+std::string render_program_options(const RenderSettings& settings);
+
+// The user's estimator file, if any, as the replacement of kernels/user_estimator.cl.
+KernelReplacements render_program_replacements(const RenderSettings& settings);
+
+// The render program built (once per process) for the device. A build error in a user's
+// estimator file throws InputError whose first line names FILE:LINE and the compiler's message,
+// followed by the build log; any other build failure throws RuntimeError with the log.
+cl::Program render_program(const DeviceContext& device, const RenderSettings& settings);
+
+// The text of a user's estimator file; throws InputError when it is not a readable regular file.
+std::string read_estimator_file(const std::string& path);
+
+}  // namespace mcrt

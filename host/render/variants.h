@@ -1,0 +1,66 @@
+// Every estimator, light selection, sampler and MIS heuristic, each one row of one table: the
+// name the command line, the stats and the scripts use; the kernel option it compiles to,
+// written out in full; what it uses; one line of description. The CLI's validation and --help,
+// the kernel options, `mcrt variants --json` (read by the scripts) and the tests read these
+// tables; adding a built-in estimator is one kernel function plus one row (docs/ESTIMATORS.md).
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace mcrt {
+
+// What an estimator uses, as bits of EstimatorVariant::uses.
+enum EstimatorUses : unsigned {
+    kUsesLights = 1u << 0,        // samples or hits emissive triangles (warn when there are none)
+    kUsesSky = 1u << 1,           // sees the uniform sky (--sky, --ao-distance); camera misses too
+    kUsesMisHeuristic = 1u << 2,  // weights strategies with --mis-heuristic
+    kUsesBsdfSampling = 1u << 3,  // draws directions from the BSDF
+};
+
+struct EstimatorVariant {
+    const char* name;      // --estimator
+    const char* function;  // the kernel function, compiled in as -D MCRT_ESTIMATE=<function>
+    unsigned uses;         // EstimatorUses bits
+    const char* description;
+};
+
+// A light selection, sampler or MIS heuristic: a -D option of the kernels.
+struct OptionVariant {
+    const char* name;   // --light-select, --sampler, --mis-heuristic
+    const char* macro;  // the -D option it compiles to; nullptr: none (the kernels' default)
+    const char* description;
+};
+
+extern const std::vector<EstimatorVariant> kEstimatorVariants;
+extern const std::vector<OptionVariant> kLightSelectVariants;
+extern const std::vector<OptionVariant> kSamplerVariants;
+extern const std::vector<OptionVariant> kMisHeuristicVariants;
+
+// The row named `name`; throws InputError naming `option` and the accepted names.
+const EstimatorVariant& estimator_variant(const std::string& name);
+const OptionVariant& option_variant(const std::vector<OptionVariant>& table,
+                                    const std::string& name, const char* option);
+
+// The rows' names, in table order (CLI11's IsMember, --help, the tests).
+std::vector<std::string> variant_names(const std::vector<EstimatorVariant>& table);
+std::vector<std::string> variant_names(const std::vector<OptionVariant>& table);
+
+// Names of the `uses` bits, for --help, the stats and `mcrt variants`.
+std::vector<std::string> uses_names(unsigned uses);
+
+// What a user's --estimator-file is assumed to use: lights and the MIS heuristic (it may call
+// mis_weight); the sky only when the file defines ESTIMATOR_USES_SKY (docs/ESTIMATORS.md).
+constexpr unsigned kUserEstimatorUses = kUsesLights | kUsesMisHeuristic;
+
+// The function a user's estimator file defines.
+constexpr const char* kUserEstimatorFunction = "estimate";
+
+// Every table as JSON text (`mcrt variants --json`).
+std::string variants_json();
+
+// Every table as aligned text (`mcrt variants`).
+std::string variants_text();
+
+}  // namespace mcrt

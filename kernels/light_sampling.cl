@@ -1,0 +1,204 @@
+/* The light strategies: a light and a point (or direction) on it from two random numbers, with
+ * the emitted radiance, the density in the sample's own measure and the selection pmf; and the
+ * twins that give the density of a direction found otherwise (a BSDF sample that hit a light),
+ * what MIS needs (pbrt-v4's SampleLi / PDF_Li). Estimators reach the lights only through these. */
+#ifndef MCRT_LIGHT_SAMPLING_CL
+#define MCRT_LIGHT_SAMPLING_CL
+
+#include "lights.cl"
+#include "sampling.cl"
+#include "scene.cl"
+
+/* Below this solid angle (sr) spherical triangle sampling loses precision; above the maximum it
+ * is near-degenerate too: such lights are sampled by area instead (as pbrt-v4 does). */
+#define MIN_SPHERICAL_SOLID_ANGLE 3e-4f
+#define MAX_SPHERICAL_SOLID_ANGLE 6.22f
+
+/* The measure a LightSample's pdf is expressed in. */
+#define LIGHT_MEASURE_AREA 0u        /* per unit area of the light */
+#define LIGHT_MEASURE_SOLID_ANGLE 1u /* per steradian seen from the shading point */
+
+typedef struct {
+    float3 wi;       /* unit, from the shading point toward y */
+    float3 y;        /* the sampled point on the light */
+    float3 n_toward; /* the light's geometric normal on the shading point's side (ray offset) */
+    float3 Le;       /* radiance the light emits toward the shading point */
+    float pmf;       /* probability of having chosen this light */
+    float pdf;       /* density of y given the light, in `measure` */
+    float d2;        /* |y − x|² */
+    float cos_light; /* cosine at the light between its emitting normal and −wi, > 0 */
+    uint measure;    /* LIGHT_MEASURE_AREA or LIGHT_MEASURE_SOLID_ANGLE */
+    uint light;      /* index of the chosen light */
+    bool valid;      /* false: the sample adds nothing (no lights, a back face, degenerate) */
+} LightSample;
+
+inline LightSample no_light_sample(void) {
+    LightSample ls;
+    ls.wi = ls.y = ls.n_toward = ls.Le = (float3)(0.0f);
+    ls.pmf = ls.pdf = ls.d2 = ls.cos_light = 0.0f;
+    ls.measure = LIGHT_MEASURE_AREA;
+    ls.light = 0u;
+    ls.valid = false;
+    return ls;
+}
+
+/* An area density converted to solid angle at distance² d2 and light cosine cos_light
+ * (PBRT 3rd ed. 14.2.2; Veach 1997 eq. 8.4). */
+inline float pdf_area_to_solid_angle(float pdf_a, float d2, float cos_light) {
+    return pdf_a * d2 / cos_light;
+}
+
+/* Solid-angle density of the area strategy, the light's selection pmf included: the one form
+ * that its sampler and its twin both use. */
+inline float light_area_pdf_w(float pmf, float pdf_a, float d2, float cos_light) {
+    return pmf * pdf_a * d2 / cos_light;
+}
+
+/* ---- Area strategy: (light, point) with density pmf(light)/area ------------------------------ */
+
+inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint* sp,
+                                     float u_select, float2 u_point) {
+    LightSample ls = no_light_sample();
+    if (scene->lights.light_count == 0u) return ls;
+    DiscreteSample choice = select_light(&scene->lights, u_select);
+    Light light = scene->lights.lights[choice.index];
+    LightPoint lp = sample_light_point(&light, u_point);
+    float3 to_light = lp.p - sp->p;
+    float d2 = dot(to_light, to_light);
+    if (!(d2 > 0.0f)) return ls;
+    float3 wi = to_light * rsqrt(d2);
+    float3 n_light = light_normal(&light);
+    float cos_y = light_emitting_cosine(&light, n_light, wi);
+    if (cos_y <= 0.0f) return ls; /* the light's back face */
+    ls.wi = wi;
+    ls.y = lp.p;
+    ls.n_toward = dot(n_light, wi) < 0.0f ? n_light : -n_light;
+    ls.Le = light.Le.xyz;
+    ls.pmf = choice.pmf;
+    ls.pdf = lp.pdf_a;
+    ls.d2 = d2;
+    ls.cos_light = cos_y;
+    ls.measure = LIGHT_MEASURE_AREA;
+    ls.light = choice.index;
+    ls.valid = true;
+    return ls;
+}
+
+/* ---- Solid-angle strategy: directions uniform in the light's spherical triangle (Arvo 1995) -- */
+
+/* Density pmf(light)/Ω, no 1/d² left in the estimate. Tiny or huge solid angles fall back to
+ * area sampling, a choice fixed by (point, light), so the estimator stays unbiased. */
+inline LightSample sample_light_solid_angle(const SceneView* scene, const SurfacePoint* sp,
+                                            float u_select, float2 u) {
+    LightSample ls = no_light_sample();
+    if (scene->lights.light_count == 0u) return ls;
+    DiscreteSample choice = select_light(&scene->lights, u_select);
+    Light light = scene->lights.lights[choice.index];
+    float3 n_light = light_normal(&light);
+    float3 x = sp->p;
+    /* A one-sided light seen from behind its plane shows only its back. */
+    if (!light_double_sided(&light) && dot(n_light, x - light.p0.xyz) <= 0.0f) return ls;
+
+    float3 a = normalize(light.p0.xyz - x), b = normalize(light.p1.xyz - x),
+           c = normalize(light.p2.xyz - x);
+    float omega = spherical_triangle_solid_angle(a, b, c);
+    float3 wi, y;
+    float pdf_w;
+    if (omega > MIN_SPHERICAL_SOLID_ANGLE && omega < MAX_SPHERICAL_SOLID_ANGLE) {
+        wi = sample_spherical_triangle_omega(a, b, c, omega, u);
+        pdf_w = 1.0f / omega;
+        /* Where the direction meets the light's plane. */
+        float denom = dot(wi, n_light);
+        float t = dot(light.p0.xyz - x, n_light) / denom;
+        if (!(t > 0.0f) || !isfinite(t)) return ls;
+        y = x + t * wi;
+    } else {
+        LightPoint lp = sample_light_point(&light, u);
+        float3 to_light = lp.p - x;
+        float d2 = dot(to_light, to_light);
+        if (!(d2 > 0.0f)) return ls;
+        wi = to_light * rsqrt(d2);
+        float cos_y = light_emitting_cosine(&light, n_light, wi);
+        if (cos_y <= 0.0f) return ls;
+        pdf_w = pdf_area_to_solid_angle(lp.pdf_a, d2, cos_y);
+        y = lp.p;
+    }
+    float cos_y = light_emitting_cosine(&light, n_light, wi);
+    if (cos_y <= 0.0f) return ls;
+    float3 d = y - x;
+    ls.wi = wi;
+    ls.y = y;
+    ls.n_toward = dot(n_light, wi) < 0.0f ? n_light : -n_light;
+    ls.Le = light.Le.xyz;
+    ls.pmf = choice.pmf;
+    ls.pdf = pdf_w;
+    ls.d2 = dot(d, d);
+    ls.cos_light = cos_y;
+    ls.measure = LIGHT_MEASURE_SOLID_ANGLE;
+    ls.light = choice.index;
+    ls.valid = true;
+    return ls;
+}
+
+/* ---- Using a light sample ---------------------------------------------------------------------- */
+
+/* cosθ_x · G / density, in the sample's own measure: cosθ_x cosθ_y / (d² pdf_a pmf) per area,
+ * cosθ_x / (pdf_w pmf) per solid angle, so that f · Le · weight is the estimate. */
+inline float light_sample_weight(const LightSample* ls, float cos_x) {
+    if (ls->measure == LIGHT_MEASURE_AREA)
+        return cos_x * ls->cos_light / (ls->d2 * ls->pdf * ls->pmf);
+    return cos_x / (ls->pdf * ls->pmf);
+}
+
+/* Density of the sample's direction with respect to solid angle, the selection included. */
+inline float light_sample_pdf_w(const LightSample* ls) {
+    if (ls->measure == LIGHT_MEASURE_AREA)
+        return light_area_pdf_w(ls->pmf, ls->pdf, ls->d2, ls->cos_light);
+    return ls->pdf * ls->pmf;
+}
+
+/* True if nothing blocks the segment from the shading point to the light sample. */
+inline bool light_sample_visible(const SceneView* scene, const SurfacePoint* sp,
+                                 const LightSample* ls) {
+    return visible(scene, sp->p, sp->n, ls->y, ls->n_toward);
+}
+
+/* ---- The twins: densities of a direction wi from sp that hit the light at `seen` ------------- */
+
+/* Density with respect to solid angle with which sample_light_area would have chosen wi; 0 when
+ * `seen` is not a light. */
+inline float pdf_light_area(const SceneView* scene, const SurfacePoint* sp,
+                            const SurfacePoint* seen, float3 wi) {
+    if (seen->light == 0u || scene->lights.light_count == 0u) return 0.0f;
+    uint index = seen->light - 1u;
+    Light light = scene->lights.lights[index];
+    float3 d = seen->p - sp->p;
+    float cos_y = fabs(dot(seen->n, wi));
+    return light_area_pdf_w(light_pmf(&scene->lights, index),
+                            sample_triangle_uniform_pdf_a(light_area(&light)), dot(d, d), cos_y);
+}
+
+/* Density with respect to solid angle with which sample_light_solid_angle would have chosen wi;
+ * 0 when `seen` is not a light or shows its back. */
+inline float pdf_light_solid_angle(const SceneView* scene, const SurfacePoint* sp,
+                                   const SurfacePoint* seen, float3 wi) {
+    if (seen->light == 0u || scene->lights.light_count == 0u) return 0.0f;
+    uint index = seen->light - 1u;
+    Light light = scene->lights.lights[index];
+    float3 n_light = light_normal(&light);
+    float3 x = sp->p;
+    if (!light_double_sided(&light) && dot(n_light, x - light.p0.xyz) <= 0.0f) return 0.0f;
+    float cos_y = light_emitting_cosine(&light, n_light, wi);
+    if (cos_y <= 0.0f) return 0.0f;
+    float3 a = normalize(light.p0.xyz - x), b = normalize(light.p1.xyz - x),
+           c = normalize(light.p2.xyz - x);
+    float omega = spherical_triangle_solid_angle(a, b, c);
+    float pmf = light_pmf(&scene->lights, index);
+    if (omega > MIN_SPHERICAL_SOLID_ANGLE && omega < MAX_SPHERICAL_SOLID_ANGLE)
+        return pmf / omega;
+    float3 d = seen->p - x;
+    return pmf * pdf_area_to_solid_angle(sample_triangle_uniform_pdf_a(light_area(&light)),
+                                         dot(d, d), cos_y);
+}
+
+#endif
