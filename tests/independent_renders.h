@@ -5,23 +5,50 @@
 
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "render/gpu_scene.h"
 #include "render/renderer.h"
+#include "render/variants.h"
 
 namespace mcrt::test {
 
-inline const char* sampler_name(SamplerKind s) {
-    return s == SamplerKind::Independent ? "independent"
-           : s == SamplerKind::Stratified ? "stratified"
-                                          : "sobol";
-}
+// One estimator of the table of variants with one MIS heuristic (every heuristic for the
+// estimators that use one, else the default): the cases the statistical suites run.
+struct EstimatorCase {
+    const EstimatorVariant* row;
+    std::string heuristic;
+    bool uses(unsigned bit) const { return (row->uses & bit) != 0; }
+    // "mis (power)" for a non-default heuristic, else the estimator's name.
+    std::string label() const {
+        return std::string(row->name) +
+               (heuristic != kMisHeuristicVariants.front().name ? " (" + heuristic + ")" : "");
+    }
+    // Every light selection for estimators that choose a light; the default for the others.
+    std::vector<std::string> selections() const {
+        return uses(kUsesLightSelection) ? variant_names(kLightSelectVariants)
+                                 : std::vector<std::string>{RenderSettings().light_select};
+    }
+    void apply(RenderSettings& s) const {
+        s.estimator = row->name;
+        s.mis_heuristic = heuristic;
+    }
+};
 
-inline const char* select_name(LightSelect s) {
-    return s == LightSelect::Uniform ? "uniform" : s == LightSelect::Power ? "power" : "alias";
+// Every estimator whose uses include all of `with` and none of `without`.
+inline std::vector<EstimatorCase> estimator_cases(unsigned with, unsigned without = 0) {
+    std::vector<EstimatorCase> cases;
+    for (const EstimatorVariant& row : kEstimatorVariants) {
+        if ((row.uses & with) != with || (row.uses & without) != 0) continue;
+        if (row.uses & kUsesMisHeuristic)
+            for (const std::string& h : variant_names(kMisHeuristicVariants)) cases.push_back({&row, h});
+        else
+            cases.push_back({&row, RenderSettings().mis_heuristic});
+    }
+    return cases;
 }
 
 // The scene's BVH and device arrays for a render of `settings`' size seen from `camera`.

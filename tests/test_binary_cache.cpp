@@ -345,11 +345,11 @@ TEST_CASE("cached_program stores the render kernel in the binary cache", "[cache
     setenv("POCL_KERNEL_CACHE", "0", 1);
     DeviceContext device = first_device();
     TempCache cache;
-    cl::Program program = cached_program(device, "render.cl", "-D ESTIMATOR_LIGHT_AREA");
+    cl::Program program = cached_program(device, "render.cl", "-D MCRT_ESTIMATE=estimate_light_area");
     unsetenv("POCL_KERNEL_CACHE");
     CHECK(program());
     CHECK(cache.files().size() == 1);
     BuildReport report;
-    build(device, kernel_source("render.cl"), "-D ESTIMATOR_LIGHT_AREA", report);
+    build(device, kernel_source("render.cl"), "-D MCRT_ESTIMATE=estimate_light_area", report);
     CHECK(report.cache_hit);
 }

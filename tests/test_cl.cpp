@@ -83,25 +83,35 @@ TEST_CASE("a failing build raises an error carrying the build log and the right 
     }
 }
 
-TEST_CASE("the device sees the shared structs with the host's sizes", "[cl]") {
+TEST_CASE("the device sees every shared struct with the host's size, alignment and offsets",
+          "[cl]") {
+    using namespace gpu;
+    // The host's view, from the same list the device probe walks (MCRT_SHARED_LAYOUT).
+    std::vector<cl_uint> want;
+    std::vector<std::string> what;
+#define HOST_TYPE(T, size, align)                    \
+    want.push_back(sizeof(T)), what.push_back("sizeof " #T); \
+    want.push_back(alignof(T)), what.push_back("alignof " #T);
+#define HOST_FIELD(T, member, offset) \
+    want.push_back(offsetof(T, member)), what.push_back("offsetof " #T "." #member);
+    MCRT_SHARED_LAYOUT(HOST_TYPE, HOST_FIELD)
+#undef HOST_TYPE
+#undef HOST_FIELD
+    REQUIRE(want.size() > 40);
+
     DeviceContext device = first_device();
-    cl::Program program = build_program(device.context, device.info.device,
-                                        kernel_source("render.cl"), "-D ESTIMATOR_LIGHT_AREA");
-    cl::Kernel kernel = make_kernel(program, "shared_type_sizes");
+    cl::Program program = build_program(device.context, device.info.device, kernel_source("render.cl"),
+                                        "-D MCRT_ESTIMATE=estimate_light_area");
+    cl::Kernel kernel = make_kernel(program, "shared_type_layout");
     cl_int status;
-    cl::Buffer sizes(device.context, CL_MEM_WRITE_ONLY, 9 * sizeof(cl_uint), nullptr, &status);
+    cl::Buffer layout(device.context, CL_MEM_WRITE_ONLY, want.size() * sizeof(cl_uint), nullptr, &status);
     REQUIRE(status == CL_SUCCESS);
-    CL_CHECK(kernel.setArg(0, sizes));
+    CL_CHECK(kernel.setArg(0, layout));
     CL_CHECK(device.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(1)));
-    cl_uint got[9] = {};
-    CL_CHECK(device.queue.enqueueReadBuffer(sizes, CL_TRUE, 0, sizeof got, got));
-    CHECK(got[0] == sizeof(gpu::BvhNode));
-    CHECK(got[1] == sizeof(gpu::Triangle));
-    CHECK(got[2] == sizeof(gpu::Material));
-    CHECK(got[3] == sizeof(gpu::Light));
-    CHECK(got[4] == sizeof(gpu::CameraGpu));
-    CHECK(got[5] == sizeof(gpu::AliasEntry));
-    CHECK(got[6] == sizeof(gpu::Bvh4Node));
-    CHECK(got[7] == sizeof(gpu::TrianglePacket));
-    CHECK(got[8] == sizeof(gpu::TriangleInfo));
+    std::vector<cl_uint> got(want.size());
+    CL_CHECK(device.queue.enqueueReadBuffer(layout, CL_TRUE, 0, got.size() * sizeof(cl_uint), got.data()));
+    for (size_t k = 0; k < want.size(); ++k) {
+        INFO(what[k] << ": host " << want[k] << ", device " << got[k]);
+        CHECK(got[k] == want[k]);
+    }
 }

@@ -1,6 +1,7 @@
 // End-to-end tests of the mcrt executable: exit status, error lines, outputs
 // (DESIGN.md "Command line", "Outputs", exit status).
 #include <algorithm>
+#include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstring>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "image/image.h"
+#include "render/variants.h"
 #include "process_support.h"
 #include "test_support.h"
 
@@ -293,28 +295,39 @@ TEST_CASE("bad usage exits 2 with one error line and writes nothing", "[cli]") {
 }
 
 TEST_CASE("every estimator, light selection and sampler renders from the command line", "[cli]") {
-    for (const char* estimator : {"hemisphere-uniform", "hemisphere-cosine", "light-area", "light-solid-angle",
-                                  "mis", "ambient-uniform", "ambient-cosine", "ambient-fibonacci"})
-        for (const char* select : {"uniform", "power", "alias"})
-            for (const char* sampler : {"independent", "stratified", "sobol"}) {
-                // Every name once; the combinations are the estimator tests' job.
-                bool light_estimator = std::string(estimator).rfind("light-", 0) == 0;
-                if (std::string(select) != "power" && !(light_estimator && std::string(sampler) == "independent"))
-                    continue;
-                Sandbox box;
-                ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("x.exr"), "--estimator",
-                                                  estimator, "--light-select", select, "--sampler", sampler},
-                                                 kSmall));
-                INFO(estimator << " / " << select << " / " << sampler << "\n  stderr: " << r.err);
-                REQUIRE(r.exit_code == 0);
-                Image img = read_exr(box.out("x.exr"));
-                double sum = 0;
-                for (float v : img.rgb) {
-                    REQUIRE(std::isfinite(v));
-                    sum += v;
-                }
-                CHECK(sum > 0);
-            }
+    // The names as `mcrt variants --json` lists them: what the scripts read.
+    Sandbox listing;
+    ProcessResult listed = listing.run({"variants", "--json"});
+    REQUIRE(listed.exit_code == 0);
+    nlohmann::json table = nlohmann::json::parse(listed.out);
+    REQUIRE(table["estimators"].size() == kEstimatorVariants.size());
+    std::vector<std::string> estimators, selections, samplers;
+    for (const auto& row : table["estimators"]) estimators.push_back(row["name"]);
+    for (const auto& row : table["light_select"]) selections.push_back(row["name"]);
+    for (const auto& row : table["samplers"]) samplers.push_back(row["name"]);
+    CHECK(estimators == variant_names(kEstimatorVariants));
+    CHECK(selections == variant_names(kLightSelectVariants));
+    CHECK(samplers == variant_names(kSamplerVariants));
+    // Every name once; the combinations are the estimator tests' job.
+    std::vector<std::array<std::string, 3>> runs;
+    for (const std::string& e : estimators) runs.push_back({e, "power", "independent"});
+    for (const std::string& l : selections) runs.push_back({"light-area", l, "independent"});
+    for (const std::string& g : samplers) runs.push_back({"light-area", "power", g});
+    for (const auto& [estimator, select, sampler] : runs) {
+        Sandbox box;
+        ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("x.exr"), "--estimator",
+                                          estimator, "--light-select", select, "--sampler", sampler},
+                                         kSmall));
+        INFO(estimator << " / " << select << " / " << sampler << "\n  stderr: " << r.err);
+        REQUIRE(r.exit_code == 0);
+        Image img = read_exr(box.out("x.exr"));
+        double sum = 0;
+        for (float v : img.rgb) {
+            REQUIRE(std::isfinite(v));
+            sum += v;
+        }
+        CHECK(sum > 0);
+    }
 }
 
 TEST_CASE("a rejected render leaves an existing output untouched", "[cli]") {

@@ -44,32 +44,20 @@ TEST_CASE("direct-light estimators are unbiased on a polygon light over a plane"
     GpuSceneData data = gpu_scene_for(ps.scene, ps.camera, settings);
     glm::dvec3 exact = image_mean(ps.exact_image(settings.width, settings.height));
 
-    struct Variant {
-        const char* estimator;
-        MisHeuristic heuristic;
-        bool uses_lights;
-    };
-    const Variant variants[] = {{"light-area", MisHeuristic::Balance, true},
-                                {"light-solid-angle", MisHeuristic::Balance, true},
-                                {"mis", MisHeuristic::Balance, true},
-                                {"mis", MisHeuristic::Power, true},
-                                {"hemisphere-uniform", MisHeuristic::Balance, false},
-                                {"hemisphere-cosine", MisHeuristic::Balance, false}};
-    for (const Variant& v : variants)
-        for (LightSelect select : {LightSelect::Uniform, LightSelect::Power, LightSelect::Alias}) {
-            if (!v.uses_lights && select != LightSelect::Power) continue;
-            for (SamplerKind sampler :
-                 {SamplerKind::Independent, SamplerKind::Stratified, SamplerKind::Sobol}) {
-                settings.estimator = v.estimator;
-                settings.mis_heuristic = v.heuristic;
+    // Every direct estimator of the table: those that use lights and not the sky.
+    const std::vector<EstimatorCase> cases = estimator_cases(kUsesLights, kUsesSky);
+    REQUIRE(cases.size() >= 6);
+    for (const EstimatorCase& v : cases)
+        for (const std::string& select : v.selections()) {
+            bool selects = v.uses(kUsesLightSelection);
+            for (const std::string& sampler : variant_names(kSamplerVariants)) {
+                v.apply(settings);
                 settings.light_select = select;
                 settings.sampler = sampler;
                 // Hemisphere sampling rarely finds these small lights: give it more samples.
-                settings.spp = v.uses_lights ? 64 : 1024;
+                settings.spp = selects ? 64 : 1024;
                 Renders r = independent_renders(device, data, settings, kRenders, kFirstSeed);
-                std::string what = std::string(v.estimator) +
-                                   (v.heuristic == MisHeuristic::Power ? " (power)" : "") + " / " +
-                                   select_name(select) + " / " + sampler_name(sampler);
+                std::string what = v.label() + " / " + select + " / " + sampler;
                 check_unbiased(r, exact, what);
                 // Not vacuous: the error bar is a few percent of the value at most.
                 CHECK(r.standard_error.x < 0.05 * exact.x);
@@ -93,9 +81,9 @@ TEST_CASE("in a furnace every estimator is unbiased and the cosine estimator has
     settings.spp = 32;
     GpuSceneData data = gpu_scene_for(scene, camera, settings);
     glm::dvec3 exact = glm::dvec3(Le) * (1.0 + glm::dvec3(albedo));
-    for (const char* estimator :
-         {"light-area", "light-solid-angle", "mis", "hemisphere-uniform", "hemisphere-cosine"}) {
-        settings.estimator = estimator;
+    for (const EstimatorCase& v : estimator_cases(kUsesLights, kUsesSky | kUsesMisHeuristic)) {
+        const std::string estimator = v.row->name;
+        v.apply(settings);
         Renders r = independent_renders(device, data, settings, kRenders, kFirstSeed);
         if (std::string(estimator) == "hemisphere-cosine") {
             // f·Le·cosθ / (cosθ/π) = ρ·Le for every sample: only rounding is left.
@@ -136,13 +124,14 @@ TEST_CASE("ambient estimators are unbiased next to a wall (its projected solid a
         double form_factor = lambert_irradiance(wall_polygon, p, {0, 1, 0}, 1.0) / M_PI;
         return albedo * sky * (1.0 - form_factor);
     }));
-    for (const char* estimator : {"ambient-uniform", "ambient-cosine", "ambient-fibonacci"})
-        for (SamplerKind sampler :
-             {SamplerKind::Independent, SamplerKind::Stratified, SamplerKind::Sobol}) {
-            settings.estimator = estimator;
+    const std::vector<EstimatorCase> cases = estimator_cases(kUsesSky);
+    REQUIRE(cases.size() >= 3);
+    for (const EstimatorCase& v : cases)
+        for (const std::string& sampler : variant_names(kSamplerVariants)) {
+            v.apply(settings);
             settings.sampler = sampler;
             Renders r = independent_renders(device, data, settings, kRenders, kFirstSeed);
-            check_unbiased(r, exact, std::string(estimator) + " / " + sampler_name(sampler));
+            check_unbiased(r, exact, v.label() + " / " + sampler);
             CHECK(r.standard_error.x < 0.02 * exact.x);
         }
 }
@@ -175,9 +164,10 @@ TEST_CASE("power and alias selection have lower variance than uniform with unequ
     settings.spp = 64;
     GpuSceneData data = gpu_scene_for(ps.scene, ps.camera, settings);
     double layer[3];
-    for (LightSelect select : {LightSelect::Uniform, LightSelect::Power, LightSelect::Alias}) {
-        settings.light_select = select;
-        layer[int(select)] = independent_renders(device, data, settings, 4, kFirstSeed).mean_layer_variance;
+    const char* selections[3] = {"uniform", "power", "alias"};
+    for (int k = 0; k < 3; ++k) {
+        settings.light_select = selections[k];
+        layer[k] = independent_renders(device, data, settings, 4, kFirstSeed).mean_layer_variance;
     }
     INFO("variance: uniform " << layer[0] << ", power " << layer[1] << ", alias " << layer[2]);
     CHECK(layer[1] < layer[0]);

@@ -345,7 +345,7 @@ std::vector<unsigned char> file_bytes(const std::string& path) {
 }
 
 TEST_CASE("load_gltf_from_memory imports what load_gltf imports", "[gltf][memory]") {
-    for (const std::string& name : {"trs_transform.gltf", "shared_subtree.gltf"}) {
+    for (const char* name : {"trs_transform.gltf", "shared_subtree.gltf"}) {
         INFO(name);
         const mcrt::Scene from_file = mcrt::load_gltf(test_data(name), nullptr);
         const mcrt::Scene from_memory =

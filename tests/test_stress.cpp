@@ -155,26 +155,13 @@ std::vector<double> exact_image(const Scene& scene, const Camera& camera, int w,
 
 // ---- Renders -----------------------------------------------------------------------------------
 
-struct Variant {
-    const char* estimator;
-    MisHeuristic heuristic;
-    bool uses_lights;  // light selection matters
-    bool direct;       // direct mode: the exact image applies
-};
+// Every estimator of the table; the direct ones (not the sky's) have the exact image.
+const std::vector<EstimatorCase> kVariants = estimator_cases(0);
 
-const Variant kVariants[] = {{"light-area", MisHeuristic::Balance, true, true},
-                             {"light-solid-angle", MisHeuristic::Balance, true, true},
-                             {"mis", MisHeuristic::Balance, true, true},
-                             {"mis", MisHeuristic::Power, true, true},
-                             {"hemisphere-uniform", MisHeuristic::Balance, false, true},
-                             {"hemisphere-cosine", MisHeuristic::Balance, false, true},
-                             {"ambient-uniform", MisHeuristic::Balance, false, false},
-                             {"ambient-cosine", MisHeuristic::Balance, false, false},
-                             {"ambient-fibonacci", MisHeuristic::Balance, false, false}};
+bool direct(const EstimatorCase& v) { return !v.uses(kUsesSky); }
 
-std::string variant_name(const Variant& v, LightSelect s) {
-    return std::string(v.estimator) + (v.heuristic == MisHeuristic::Power ? " (power)" : "") +
-           (v.uses_lights ? std::string(" / ") + select_name(s) : "");
+std::string variant_name(const EstimatorCase& v, const std::string& select) {
+    return v.label() + (v.uses(kUsesLightSelection) ? " / " + select : "");
 }
 
 std::string format(glm::dvec3 v) {
@@ -237,15 +224,12 @@ TEST_CASE(
         glm::dvec3 exact = image_mean(exact_image(scene, scene.cameras.front(), 16, 16));
         std::map<std::string, Renders> ambient;
         std::map<std::string, double> standard_error;  // red channel, by variant_name
-        for (const Variant& v : kVariants)
-            for (LightSelect select :
-                 {LightSelect::Uniform, LightSelect::Power, LightSelect::Alias}) {
-                if (!v.uses_lights && select != LightSelect::Power) continue;
-                settings.estimator = v.estimator;
-                settings.mis_heuristic = v.heuristic;
+        for (const EstimatorCase& v : kVariants)
+            for (const std::string& select : v.selections()) {
+                v.apply(settings);
                 settings.light_select = select;
                 // Direction sampling finds small lights rarely: more samples (as test_estimators).
-                bool directions = std::string(v.estimator).rfind("hemisphere", 0) == 0;
+                bool directions = direct(v) && !v.uses(kUsesLightSelection);
                 settings.spp = directions ? 256 : 32;
                 Renders r = independent_renders(device, data, settings, kRenders, kFirstSeed);
                 std::string what = name + ": " + variant_name(v, select);
@@ -254,11 +238,11 @@ TEST_CASE(
                 CHECK(r.nan_samples == 0);
                 CHECK(r.non_finite_pixels == 0);
                 standard_error[variant_name(v, select)] = r.standard_error.x;
-                if (!v.direct) {
-                    ambient[v.estimator] = r;
+                if (!direct(v)) {
+                    ambient[v.row->name] = r;
                     continue;
                 }
-                if (kNoStandardError.count({name, v.estimator})) continue;
+                if (kNoStandardError.count({name, v.row->name})) continue;
                 for (int c = 0; c < 3; ++c)
                     CHECK(std::abs(r.mean[c] - exact[c]) <= 4.5 * r.standard_error[c]);
             }
@@ -300,11 +284,10 @@ TEST_CASE("stress: a light facing away from the receiver adds exactly nothing",
     GpuSceneData data =
         make_gpu_scene(scene, bvh, scene.cameras.front(), settings.width, settings.height);
     REQUIRE(data.lights.size() == 2);
-    for (const Variant& v : kVariants)
-        for (LightSelect select : {LightSelect::Uniform, LightSelect::Power, LightSelect::Alias}) {
-            if (!v.direct || (!v.uses_lights && select != LightSelect::Power)) continue;
-            settings.estimator = v.estimator;
-            settings.mis_heuristic = v.heuristic;
+    for (const EstimatorCase& v : kVariants)
+        for (const std::string& select : v.selections()) {
+            if (!direct(v)) continue;
+            v.apply(settings);
             settings.light_select = select;
             RenderResult r = render(device, data, settings);
             INFO(variant_name(v, select));
@@ -343,7 +326,7 @@ TEST_CASE("stress scenes through the executable: exit 0, finite EXR, nan_samples
           "[stress][cli]") {
     TempDir tmp("mcrt-stress");
     for (const std::string& name : kStressScenes)
-        for (const std::string& estimator : kEstimators) {
+        for (const std::string& estimator : variant_names(kEstimatorVariants)) {
             // Uniform selection picks the slivers and the dim lights as often as any other.
             std::string exr = tmp / (name + ".exr"), stats = tmp / (name + ".json");
             std::vector<std::string> args = {"render",         stress_path(name),

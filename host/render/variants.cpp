@@ -12,11 +12,11 @@ const std::vector<EstimatorVariant> kEstimatorVariants = {
      "directions uniform on the hemisphere, pdf 1/(2 pi), counting the emitters they hit (GI Compendium eq. 34)"},
     {"hemisphere-cosine", "estimate_hemisphere_cosine", kUsesLights,
      "cosine-weighted directions, pdf cos/pi, counting the emitters they hit (eq. 35)"},
-    {"light-area", "estimate_light_area", kUsesLights,
+    {"light-area", "estimate_light_area", kUsesLights | kUsesLightSelection,
      "a light by --light-select and a uniform point on it, pdf pmf/area converted by cos_y/d^2"},
-    {"light-solid-angle", "estimate_light_solid_angle", kUsesLights,
+    {"light-solid-angle", "estimate_light_solid_angle", kUsesLights | kUsesLightSelection,
      "a light by --light-select and a direction uniform in its spherical triangle (Arvo 1995), area below 3e-4 sr"},
-    {"mis", "estimate_mis", kUsesLights | kUsesMisHeuristic | kUsesBsdfSampling,
+    {"mis", "estimate_mis", kUsesLights | kUsesLightSelection | kUsesMisHeuristic | kUsesBsdfSampling,
      "one light-area and one BSDF sample, weighted by --mis-heuristic (Veach 1997)"},
     {"ambient-uniform", "estimate_ambient_uniform", kUsesSky,
      "ambient light: sky visibility over uniform directions, albedo x L_sky x (1/pi) int V cos"},
@@ -86,6 +86,7 @@ std::vector<std::string> variant_names(const std::vector<OptionVariant>& table) 
 std::vector<std::string> uses_names(unsigned uses) {
     std::vector<std::string> names;
     if (uses & kUsesLights) names.push_back("lights");
+    if (uses & kUsesLightSelection) names.push_back("light-selection");
     if (uses & kUsesSky) names.push_back("sky");
     if (uses & kUsesMisHeuristic) names.push_back("mis-heuristic");
     if (uses & kUsesBsdfSampling) names.push_back("bsdf-sampling");

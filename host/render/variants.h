@@ -13,10 +13,11 @@ namespace mcrt {
 
 // What an estimator uses, as bits of EstimatorVariant::uses.
 enum EstimatorUses : unsigned {
-    kUsesLights = 1u << 0,        // samples or hits emissive triangles (warn when there are none)
-    kUsesSky = 1u << 1,           // sees the uniform sky (--sky, --ao-distance); camera misses too
-    kUsesMisHeuristic = 1u << 2,  // weights strategies with --mis-heuristic
-    kUsesBsdfSampling = 1u << 3,  // draws directions from the BSDF
+    kUsesLights = 1u << 0,          // samples or hits emissive triangles (warn when there are none)
+    kUsesLightSelection = 1u << 1,  // chooses among the lights with --light-select
+    kUsesSky = 1u << 2,             // sees the uniform sky (--sky, --ao-distance); camera misses too
+    kUsesMisHeuristic = 1u << 3,    // weights strategies with --mis-heuristic
+    kUsesBsdfSampling = 1u << 4,    // draws directions from the BSDF
 };
 
 struct EstimatorVariant {
@@ -50,9 +51,9 @@ std::vector<std::string> variant_names(const std::vector<OptionVariant>& table);
 // Names of the `uses` bits, for --help, the stats and `mcrt variants`.
 std::vector<std::string> uses_names(unsigned uses);
 
-// What a user's --estimator-file is assumed to use: lights and the MIS heuristic (it may call
-// mis_weight); the sky only when the file defines ESTIMATOR_USES_SKY (docs/ESTIMATORS.md).
-constexpr unsigned kUserEstimatorUses = kUsesLights | kUsesMisHeuristic;
+// What a user's --estimator-file is assumed to use: lights, their selection and the MIS
+// heuristic (it may call mis_weight); the sky only when the file defines ESTIMATOR_USES_SKY (docs/ESTIMATORS.md).
+constexpr unsigned kUserEstimatorUses = kUsesLights | kUsesLightSelection | kUsesMisHeuristic;
 
 // The function a user's estimator file defines.
 constexpr const char* kUserEstimatorFunction = "estimate";
