@@ -5,6 +5,7 @@
 #include <csignal>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -17,11 +18,18 @@
 #include "bvh/bvh.h"
 #include "cl/cl_error.h"
 #include "cl/device.h"
+#include "cl/no_device.h"
 #include "cli/integrate.h"
 #include "cli/progress.h"
+#include "cli/usage_errors.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/output_paths.h"
+#include "common/stop_signals.h"
+#include "common/value_limits.h"
 #include "image/image.h"
+#include "image/image_check.h"
+#include "render/memory_estimate.h"
 #include "render/renderer.h"
 #include "scene/gltf_import.h"
 
@@ -45,6 +53,7 @@ struct InterruptGuard {
         sigaction(SIGTERM, &action, &old_term);
     }
     ~InterruptGuard() {
+        if (outputs_are_complete()) return;  // stop signals stay ignored: nothing left to save
         sigaction(SIGINT, &old_int, nullptr);
         sigaction(SIGTERM, &old_term, nullptr);
     }
@@ -85,19 +94,10 @@ const CLI::Validator kFinite(
     },
     "FINITE");
 
-// An output's directory must exist before rendering starts, not after.
-void check_output_path(const std::string& path, const char* option) {
-    if (path.empty()) return;
-    std::filesystem::path dir = std::filesystem::path(path).parent_path();
-    if (!dir.empty() && !std::filesystem::is_directory(dir))
-        throw InputError(std::string(option) + " " + path + ": directory " + dir.string() +
-                         " does not exist");
-}
-
 // Devices named by --device (index, cpu, gpu, all; repeatable), in list order, no duplicates.
 std::vector<DeviceInfo> select_devices(const std::vector<std::string>& specs) {
     std::vector<DeviceInfo> all = enumerate_devices(print_warning);
-    if (all.empty()) throw RuntimeError("no OpenCL device found (is an ICD such as PoCL installed?)");
+    if (all.empty()) throw RuntimeError(no_device_message());
     if (specs.empty()) return {all.front()};
     std::set<int> chosen;
     for (const std::string& spec : specs) {
@@ -130,10 +130,10 @@ glm::vec3 parse_sky(const std::string& text) {
         try {
             size_t used = 0;
             float x = std::stof(item, &used);
-            if (used != item.size() || !std::isfinite(x) || x < 0) throw std::invalid_argument(item);
+            if (used != item.size() || !std::isfinite(x) || x < 0 || x > kMaxRadiance) throw std::invalid_argument(item);
             v.push_back(x);
         } catch (const std::exception&) {
-            throw InputError("--sky " + text + ": expected R,G,B or one value, finite and >= 0");
+            throw InputError("--sky " + text + ": expected R,G,B or one value, each in [0, 1e15]");
         }
     }
     if (v.size() == 1) return glm::vec3(v[0]);
@@ -143,7 +143,7 @@ glm::vec3 parse_sky(const std::string& text) {
 
 int run_devices() {
     std::vector<DeviceInfo> devices = enumerate_devices(print_warning);
-    if (devices.empty()) throw RuntimeError("no OpenCL device found (is an ICD such as PoCL installed?)");
+    if (devices.empty()) throw RuntimeError(no_device_message());
     for (const DeviceInfo& d : devices) {
         std::printf("%d: %s [%s] — %s, %s, %u compute units, %.1f GiB, driver %s\n", d.index,
                     d.name.c_str(), d.type_name().c_str(), d.platform_name.c_str(),
@@ -155,9 +155,8 @@ int run_devices() {
 
 int run_render(const RenderOptions& o) {
     auto start = std::chrono::steady_clock::now();
-    check_output_path(o.out, "--out");
-    check_output_path(o.png, "--png");
-    check_output_path(o.stats, "--stats");
+    const std::vector<OutputFile> outputs = {{"--out", o.out}, {"--png", o.png}, {"--stats", o.stats}};
+    check_outputs(outputs, {o.scene});
 
     RenderSettings settings;
     settings.width = o.width;
@@ -177,7 +176,11 @@ int run_render(const RenderOptions& o) {
     settings.batch = o.batch;
     render_program_options(settings);  // rejects what is not supported before any work
 
-    Scene scene = load_gltf(o.scene, print_warning);
+    std::vector<std::string> inputs;
+    Scene scene = load_gltf(o.scene, print_warning, &inputs);
+    check_outputs(outputs, inputs);  // its buffers too
+    check_host_memory("a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " render",
+                      render_host_bytes(o.width, o.height));
     if (scene.triangle_count() == 0) print_warning(o.scene + ": the scene has no triangles");
     bool ambient = o.estimator.rfind("ambient-", 0) == 0;
     if (!ambient && collect_emitters(scene).empty())
@@ -219,6 +222,10 @@ int run_render(const RenderOptions& o) {
         print_warning("stopped by " + result.stopped_by + " after " + std::to_string(result.spp) +
                       " of " + std::to_string(o.spp) + " samples per pixel; writing those");
 
+    if (uint64_t bad = nonfinite_pixels(result.image))
+        throw RuntimeError(std::to_string(bad) + " pixels are not finite (radiance overflowed single "
+                           "precision); no image written");
+
     std::map<std::string, std::string> attributes = {
         {"mcrt.scene", o.scene},         {"mcrt.estimator", o.estimator},
         {"mcrt.light_select", o.light_select}, {"mcrt.sampler", o.sampler},
@@ -251,6 +258,7 @@ int run_render(const RenderOptions& o) {
             {"rays", result.rays},
             {"rays_per_second", result.seconds_render > 0 ? result.rays / result.seconds_render : 0.0},
             {"nan_samples", result.nan_samples},
+            {"nonfinite_pixels", 0},  // any would have stopped the render above
             {"triangles", scene.triangle_count()},
             {"lights", gpu_scene.lights.size()},
             // The 4-wide tree the kernels traverse; the binary SAH tree it collapses as binary_*.
@@ -280,12 +288,13 @@ int run_render(const RenderOptions& o) {
         write_atomically(o.stats, [&](const std::string& tmp) {
             std::ofstream out(tmp);
             out << j.dump(2) << "\n";
-            if (!out) throw RuntimeError(o.stats + ": cannot write");
+            if (!out) throw RuntimeError(o.stats + ": cannot write: " + std::strerror(errno ? errno : EIO));
         });
     }
     if (!o.quiet)
         std::cerr << "mcrt: wrote " << o.out << " (" << o.width << "x" << o.height << ", "
                   << result.spp << " spp, " << result.seconds_render << " s on the device)" << std::endl;
+    outputs_complete();
     return 0;
 }
 
@@ -354,7 +363,7 @@ int run_cli(int argc, char** argv) {
     } catch (const CLI::CallForAllHelp& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        std::cerr << "mcrt: error: " << e.what() << std::endl;
+        std::cerr << "mcrt: error: " << usage_error_message(app, e, argc, argv) << std::endl;
         return 2;
     }
 

@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "cl/cl_error.h"
+#include "cl/no_device.h"
 #include "cl/program.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
@@ -113,7 +114,7 @@ IntegrateRow summarize(const std::string& estimator, int64_t n, const std::vecto
 DeviceInfo chosen_device(int64_t index) {
     std::vector<DeviceInfo> all = enumerate_devices(print_warning);
     if (all.empty())
-        throw RuntimeError("no OpenCL device found (is an ICD such as PoCL installed?)");
+        throw RuntimeError(no_device_message());
     if (index >= int64_t(all.size()))
         throw InputError("--device " + std::to_string(index) + ": no such device (" +
                          std::to_string(all.size()) + " found; see `mcrt devices`)");
