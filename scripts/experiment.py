@@ -30,6 +30,10 @@ slope guide, reference floor), error_vs_spp.png, efficiency.png (bars, at the la
 equal_time.png (a strip of image crops at equal render time with their error maps: one more
 render of each configuration under --time-limit, listed in equal_time.csv).
 
+Estimators are built-in names (`mcrt variants`) or a user's estimator files (FILE.cl, rendered
+with --estimator-file, labelled by the file's stem), e.g. --estimators light-area,my_idea.cl: a
+user's estimator is charted against the built-in ones in one command.
+
 Usage: scripts/experiment.py SCENE --estimators a,b,... [--light-select power,...]
            [--samplers independent,...] (--spp 1,4,16,... | --seconds 0.5,1,2,...)
            [--width W --height H] [--reference auto|FILE.exr] [--repeats K] --out DIR [--quick]
@@ -46,14 +50,16 @@ import re
 import shlex
 import subprocess
 import sys
-import time
 from pathlib import Path
 
-import numpy as np
+import mcrt_run
 
-from mcrt_exr import read_exr, read_exr_float_attribute, write_exr
+mcrt_run.require("numpy", "matplotlib")
+import numpy as np  # noqa: E402
 
-ROOT = Path(__file__).resolve().parent.parent
+from mcrt_exr import read_exr_float_attribute, write_exr  # noqa: E402
+
+ROOT = mcrt_run.ROOT
 RELMSE_EPSILON = 1e-2
 REFERENCE_SEEDS = (1000003, 2000003)  # far from the seeds of the measured renders
 CSV_COLUMNS = ["scene", "estimator", "light_select", "sampler", "level", "spp", "repeat", "seed",
@@ -64,31 +70,20 @@ CSV_COLUMNS = ["scene", "estimator", "light_select", "sampler", "level", "spp", 
 # ----- running mcrt ----------------------------------------------------------------------------
 
 def run_mcrt(args, scene, out_stem, estimator, light_select, sampler, seed, spp=None,
-             seconds=None, width=None, height=None):
-    """One `mcrt render`; returns (rgb (3, H, W) float64, variance (3, H, W), stats, wall s)."""
-    command = [args.mcrt, "render", str(scene), "--out", out_stem + ".exr",
-               "--stats", out_stem + ".json", "--estimator", estimator,
-               "--light-select", light_select, "--sampler", sampler, "--seed", str(seed),
-               "--width", str(width or args.width), "--height", str(height or args.height),
-               "--quiet"]
-    if estimator == "mis" and args.mis_heuristic:
-        command += ["--mis-heuristic", args.mis_heuristic]
+             seconds=None):
+    """One `mcrt render` of `estimator` (a built-in name or a .cl file); returns a
+    mcrt_run.Render (rgb and variance as (3, H, W) float64, stats, wall seconds, command)."""
+    options = mcrt_run.estimator_arguments(estimator) + [
+        "--light-select", light_select, "--sampler", sampler, "--seed", seed,
+        "--width", args.width, "--height", args.height]
+    if args.mis_heuristic and "mis-heuristic" in mcrt_run.estimator_uses(estimator, args.mcrt):
+        options += ["--mis-heuristic", args.mis_heuristic]
     if seconds is not None:
         # mcrt stops after the time limit at a whole 16-sample chunk; the spp cap is never hit.
-        command += ["--spp", "16777216", "--time-limit", repr(seconds)]
+        options += ["--spp", "16777216", "--time-limit", repr(seconds)]
     else:
-        command += ["--spp", str(spp)]
-    start = time.monotonic()
-    done = subprocess.run(command, capture_output=True, text=True)
-    wall = time.monotonic() - start
-    if done.returncode != 0:
-        sys.exit("experiment: %s\nexit %d: %s" % (shlex.join(command), done.returncode,
-                                                  done.stderr.strip()))
-    stats = json.loads(Path(out_stem + ".json").read_text())
-    exr = read_exr(out_stem + ".exr")
-    rgb = np.stack([exr[c] for c in "RGB"]).astype(np.float64)
-    variance = np.stack([exr["variance." + c] for c in "RGB"]).astype(np.float64)
-    return rgb, variance, stats, wall, command
+        options += ["--spp", spp]
+    return mcrt_run.render(scene, out_stem, options, mcrt=args.mcrt)
 
 
 def git_commit():
@@ -136,21 +131,21 @@ def auto_reference(args, scene, scratch):
     exr_path, json_path = Path(str(stem) + ".exr"), Path(str(stem) + ".json")
     if exr_path.exists() and json_path.exists():
         info = json.loads(json_path.read_text())
-        exr = read_exr(exr_path)
+        rgb, _ = mcrt_run.read_image_file(exr_path)
         print("experiment: reference from the cache: %s" % exr_path, file=sys.stderr)
-        return np.stack([exr[c] for c in "RGB"]).astype(np.float64), info, exr_path
+        return rgb, info, exr_path
 
     half = max(1, args.reference_spp // 2)
     print("experiment: rendering the reference (mis, power, sobol, 2 × %d spp, %d×%d)…"
           % (half, args.width, args.height), file=sys.stderr)
     halves, commands, seconds, wall = [], [], 0.0, 0.0
     for i, seed in enumerate(REFERENCE_SEEDS):
-        rgb, var, stats, w, command = run_mcrt(args, scene, str(scratch / ("reference-%d" % i)),
-                                               "mis", "power", "sobol", seed, spp=half)
-        halves.append((rgb, var))
-        commands.append(shlex.join(command))
-        seconds += stats["seconds_render"]
-        wall += w
+        r = run_mcrt(args, scene, str(scratch / ("reference-%d" % i)), "mis", "power", "sobol",
+                     seed, spp=half)
+        halves.append((r.rgb, r.variance))
+        commands.append(shlex.join(r.command))
+        seconds += r.stats["seconds_render"]
+        wall += r.wall_seconds
     (a, va), (b, vb) = halves
     rgb = (a + b) / 2
     variance = (va + vb) / 4
@@ -182,11 +177,9 @@ def auto_reference(args, scene, scratch):
 
 
 def file_reference(path):
-    exr = read_exr(path)
-    rgb = np.stack([exr[c] for c in "RGB"]).astype(np.float64)
+    rgb, variance = mcrt_run.read_image_file(path)
     info = {"file": str(path), "spp": read_exr_float_attribute(path, "spp")}
-    if all("variance." + c in exr for c in "RGB"):
-        variance = np.stack([exr["variance." + c] for c in "RGB"]).astype(np.float64)
+    if variance is not None:
         info["standard_error_layer"] = float(np.mean(np.sqrt(variance)))
         info["rmse_floor_layer"] = info["rmse_floor"] = math.sqrt(float(np.mean(variance)))
         info["relrmse_floor"] = math.sqrt(float(np.mean(variance / (rgb ** 2 + RELMSE_EPSILON))))
@@ -216,17 +209,7 @@ def tonemap(rgb, scale):
 
 # ----- charts ----------------------------------------------------------------------------------
 
-def save_png(fig, path):
-    """Saves a figure as a small PNG: reduced to a 256-colour palette when Pillow is there."""
-    import io
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png")
-    try:
-        from PIL import Image
-        image = Image.open(io.BytesIO(buffer.getvalue())).convert("RGB")
-        image.quantize(256, method=Image.Quantize.MEDIANCUT).save(path, optimize=True)
-    except (ImportError, AttributeError):
-        Path(path).write_bytes(buffer.getvalue())
+save_png = mcrt_run.save_png  # pixel_maps.py and mitsuba_reference.py use it here
 
 
 def grouped(rows):
@@ -346,6 +329,14 @@ def equal_time_strip(plt, images, reference, title, path, crop):
 
 # ----- main ------------------------------------------------------------------------------------
 
+ScriptError = mcrt_run.ScriptError
+
+
+def scratch_stem(scratch, *parts):
+    """A render's file stem in the scratch directory: the parts joined by '-', made safe."""
+    return str(scratch / re.sub(r"[^\w.-]", "_", "-".join(str(p) for p in parts)))
+
+
 def number_list(text, kind):
     try:
         values = [kind(v) for v in text.split(",") if v]
@@ -361,10 +352,11 @@ def parse_args(argv=None):
                                 formatter_class=argparse.RawDescriptionHelpFormatter,
                                 epilog=__doc__.split("\n\n", 1)[1])
     p.add_argument("scene")
-    p.add_argument("--estimators", required=True, help="comma-separated mcrt estimators")
+    p.add_argument("--estimators", required=True,
+                   help="comma-separated built-in estimators and/or estimator files FILE.cl")
     p.add_argument("--light-select", default="power", help="comma-separated (default power)")
     p.add_argument("--samplers", default="independent", help="comma-separated (default independent)")
-    p.add_argument("--mis-heuristic", choices=["balance", "power"], help="for estimator mis")
+    p.add_argument("--mis-heuristic", help="for the estimators that use one (mcrt variants)")
     levels = p.add_mutually_exclusive_group()
     levels.add_argument("--spp", type=lambda t: number_list(t, int), help="e.g. 1,4,16,64")
     levels.add_argument("--seconds", type=lambda t: number_list(t, float),
@@ -382,7 +374,7 @@ def parse_args(argv=None):
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--quick", action="store_true",
                    help="32×32 image, spp 1,4,16 unless given, 1 repeat, 512 spp reference")
-    p.add_argument("--mcrt", default=str(ROOT / "build" / "mcrt"), help="mcrt executable")
+    mcrt_run.add_mcrt_option(p)
     p.add_argument("--keep-images", action="store_true", help="keep every render's EXR and JSON")
     args = p.parse_args(argv)
     quick = args.quick
@@ -397,21 +389,33 @@ def parse_args(argv=None):
     return args
 
 
+def check_variants(args, estimators, selects, samplers):
+    """ScriptError for a missing scene or binary, or an unknown variant, before any render."""
+    if not Path(args.scene).exists():
+        raise ScriptError("no scene %s" % args.scene)
+    mcrt_run.mcrt_binary(args.mcrt)
+    if not estimators:
+        raise ScriptError("--estimators: no estimator given")
+    mcrt_run.check_estimators(estimators, args.mcrt)
+    mcrt_run.check_choices("light selection", selects, "light_select", args.mcrt)
+    mcrt_run.check_choices("sampler", samplers, "samplers", args.mcrt)
+    if args.mis_heuristic:
+        mcrt_run.check_choices("MIS heuristic", [args.mis_heuristic], "mis_heuristics",
+                               args.mcrt)
+
+
 def main(argv=None):
     args = parse_args(argv)
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    estimators = mcrt_run.comma_list(args.estimators)
+    selects = mcrt_run.comma_list(args.light_select)
+    samplers = mcrt_run.comma_list(args.samplers)
+    check_variants(args, estimators, selects, samplers)
+    plt = mcrt_run.pyplot()
 
     scene = Path(args.scene)
-    if not scene.exists():
-        sys.exit("experiment: error: no scene %s" % scene)
     out = Path(args.out)
     scratch = out / "renders"
     scratch.mkdir(parents=True, exist_ok=True)
-    estimators = [e for e in args.estimators.split(",") if e]
-    selects = [s for s in args.light_select.split(",") if s]
-    samplers = [s for s in args.samplers.split(",") if s]
 
     if args.reference == "auto":
         reference, ref_info, ref_path = auto_reference(args, scene, scratch)
@@ -419,8 +423,8 @@ def main(argv=None):
         reference, ref_info = file_reference(args.reference)
         ref_path = Path(args.reference)
         if reference.shape[1:] != (args.height, args.width):
-            sys.exit("experiment: error: reference %s is %d×%d, the renders %d×%d"
-                     % (args.reference, reference.shape[2], reference.shape[1], args.width,
+            raise ScriptError("reference %s is %d×%d, the renders %d×%d"
+                              % (args.reference, reference.shape[2], reference.shape[1], args.width,
                         args.height))
     floor = ref_info.get("rmse_floor", 0.0)
     rel_floor = ref_info.get("relrmse_floor", 0.0)
@@ -433,22 +437,22 @@ def main(argv=None):
     levels = args.spp if args.spp else args.seconds
     rows, images, configs = [], {}, []
     for estimator in estimators:
+        name = mcrt_run.estimator_label(estimator)  # a file's stem in the CSV and charts
         # selection only matters to the estimators that sample lights
-        for select in (selects if estimator in ("light-area", "light-solid-angle", "mis")
+        for select in (selects if mcrt_run.uses_light_select(estimator, args.mcrt)
                        else selects[:1]):
             for sampler in samplers:
                 configs.append((estimator, select, sampler))
                 for level in levels:
                     for repeat in range(args.repeats):
                         seed = args.seed + repeat
-                        stem = str(scratch / re.sub(r"[^\w.-]", "_", "%s-%s-%s-%s-%d" % (
-                            estimator, select, sampler, level, repeat)))
+                        stem = scratch_stem(scratch, name, select, sampler, level, repeat)
                         kw = {"spp": level} if args.spp else {"seconds": level}
-                        rgb, _, stats, wall, _ = run_mcrt(args, scene, stem, estimator, select,
-                                                          sampler, seed, **kw)
+                        r = run_mcrt(args, scene, stem, estimator, select, sampler, seed, **kw)
+                        rgb, stats, wall = r.rgb, r.stats, r.wall_seconds
                         mse, relmse = errors(rgb, reference)
                         seconds = stats["seconds_render"]
-                        row = {"scene": scene.name, "estimator": estimator, "light_select": select,
+                        row = {"scene": scene.name, "estimator": name, "light_select": select,
                                "sampler": sampler, "level": level, "spp": stats["spp"],
                                "repeat": repeat, "seed": seed, "seconds": seconds,
                                "wall_seconds": wall, "rmse": math.sqrt(mse), "relmse": relmse,
@@ -465,8 +469,7 @@ def main(argv=None):
                             images[(config_label(row), level)] = (rgb, seconds, math.sqrt(mse),
                                                                   stats["spp"])
                         if not args.keep_images:
-                            for suffix in (".exr", ".json"):
-                                Path(stem + suffix).unlink(missing_ok=True)
+                            mcrt_run.remove_outputs(stem)
                         print("experiment: %s, %s %s: %.3f s, RMSE %.4g" % (
                             config_label(row), level, "spp" if args.spp else "s", seconds,
                             row["rmse"]), file=sys.stderr)
@@ -498,16 +501,16 @@ def main(argv=None):
         target = min(points[max(len(points) - 2, 0)]["seconds"] for points in groups.values())
         target = max(target, 0.05)
         for (estimator, select, sampler) in configs:
-            stem = str(scratch / re.sub(r"[^\w.-]", "_", "equal-time-%s-%s-%s" % (
-                estimator, select, sampler)))
-            rgb, _, stats, _, _ = run_mcrt(args, scene, stem, estimator, select, sampler,
-                                           args.seed + 7919, seconds=target)
-            mse, _ = errors(rgb, reference)
-            label = "%s / %s / %s" % (estimator, select, sampler)
-            strip.append((label, rgb, stats["seconds_render"], math.sqrt(mse), stats["spp"]))
+            name = mcrt_run.estimator_label(estimator)
+            stem = scratch_stem(scratch, "equal-time", name, select, sampler)
+            r = run_mcrt(args, scene, stem, estimator, select, sampler, args.seed + 7919,
+                         seconds=target)
+            mse, _ = errors(r.rgb, reference)
+            label = "%s / %s / %s" % (name, select, sampler)
+            strip.append((label, r.rgb, r.stats["seconds_render"], math.sqrt(mse),
+                          r.stats["spp"]))
             if not args.keep_images:
-                for suffix in (".exr", ".json"):
-                    Path(stem + suffix).unlink(missing_ok=True)
+                mcrt_run.remove_outputs(stem)
     strip.sort(key=lambda s: s[3])
     (out / "equal_time.csv").write_text(
         "estimator,light_select,sampler,seconds,spp,rmse\n" + "".join(
@@ -519,4 +522,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(mcrt_run.script_main(main))

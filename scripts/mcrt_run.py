@@ -85,9 +85,11 @@ def run(command, env=None):
     except OSError as e:
         raise ScriptError("%s: %s" % (shlex.join(map(str, command)), e))
     if done.returncode != 0:
+        # mcrt's own "mcrt: error:" line, not what a kernel compiler printed before it
         lines = [l for l in done.stderr.strip().splitlines() if l.strip()]
+        ours = [l for l in lines if l.startswith("mcrt: error:")]
         raise ScriptError("%s exited %d: %s" % (shlex.join(map(str, command)), done.returncode,
-                                                lines[0] if lines else "(no message)"))
+                                                (ours or lines or ["(no message)"])[0]))
     return done
 
 
@@ -127,8 +129,37 @@ def estimator_uses(estimator, mcrt=None):
     for row in table["estimators"]:
         if row["name"] == estimator:
             return row["uses"]
-    raise ScriptError("unknown estimator %s (one of %s)"
+    raise ScriptError("unknown estimator %s (one of %s, or a file FILE.cl)"
                       % (estimator, ", ".join(r["name"] for r in table["estimators"])))
+
+
+def uses_light_select(estimator, mcrt=None):
+    """True when --light-select changes what `estimator` computes: it samples a light (so not
+    the hemisphere estimators, which count the emitters their directions hit, though they
+    "use" lights). The table has no bit for it yet: a "light-select" use when it has one, else
+    a built-in whose description names --light-select or that weighs with --mis-heuristic
+    (MIS samples a light); a user's file may call the light sampling API, so True."""
+    if is_estimator_file(estimator):
+        return True
+    uses = estimator_uses(estimator, mcrt)
+    if "light-select" in uses:
+        return True
+    row = next(r for r in variants(mcrt)["estimators"] if r["name"] == estimator)
+    return "--light-select" in row.get("description", "") or "mis-heuristic" in uses
+
+
+def check_estimators(estimators, mcrt=None):
+    """ScriptError unless each is a built-in estimator or an existing .cl file, and their
+    labels (estimator_label) are distinct."""
+    labels = {}
+    for e in estimators:
+        estimator_arguments(e)  # a missing file
+        estimator_uses(e, mcrt)  # an unknown name
+        label = estimator_label(e)
+        if label in labels and labels[label] != e:
+            raise ScriptError("%s and %s would both be labelled %s: rename one" % (
+                labels[label], e, label))
+        labels[label] = e
 
 
 def estimator_label(estimator):
@@ -145,9 +176,8 @@ class Render:
 
 
 def render(scene, stem, options, mcrt=None, env=None, read_image=True):
-    """`mcrt render SCENE --out STEM.exr --stats STEM.json --quiet OPTIONS`; returns a Render."""
-    from mcrt_exr import read_exr  # numpy: only once an image is read
-
+    """`mcrt render SCENE --out STEM.exr --stats STEM.json --quiet OPTIONS`; returns a Render
+    (rgb and variance None when not `read_image`: then numpy is not needed)."""
     stem = str(stem)
     command = [mcrt_binary(mcrt), "render", str(scene), "--out", stem + ".exr",
                "--stats", stem + ".json", "--quiet"] + [str(o) for o in options]
@@ -157,9 +187,88 @@ def render(scene, stem, options, mcrt=None, env=None, read_image=True):
     stats = json.loads(Path(stem + ".json").read_text())
     if not read_image:
         return Render(None, None, stats, wall, command)
-    import numpy as np
-
-    exr = read_exr(stem + ".exr")
-    rgb = np.stack([exr[c] for c in "RGB"]).astype(np.float64)
-    variance = np.stack([exr["variance." + c] for c in "RGB"]).astype(np.float64)
+    rgb, variance = read_image_file(stem + ".exr")
     return Render(rgb, variance, stats, wall, command)
+
+
+def read_image_file(path):
+    """(rgb, variance) of an EXR as (3, H, W) float64 arrays; variance None when the file has no
+    variance.R/G/B layer. ScriptError when it cannot be read."""
+    import numpy as np
+    from mcrt_exr import read_exr
+
+    try:
+        exr = read_exr(path)
+    except (OSError, ValueError, KeyError) as e:
+        raise ScriptError("cannot read %s: %s" % (path, e))
+    if not all(c in exr for c in "RGB"):
+        raise ScriptError("%s has no R, G, B channels" % path)
+    rgb = np.stack([exr[c] for c in "RGB"]).astype(np.float64)
+    variance = None
+    if all("variance." + c in exr for c in "RGB"):
+        variance = np.stack([exr["variance." + c] for c in "RGB"]).astype(np.float64)
+    return rgb, variance
+
+
+def remove_outputs(stem):
+    """Deletes STEM.exr and STEM.json of a render."""
+    for suffix in (".exr", ".json"):
+        Path(str(stem) + suffix).unlink(missing_ok=True)
+
+
+# ----- command-line helpers --------------------------------------------------------------------
+
+def comma_list(text):
+    """'a,b,,c' → ['a', 'b', 'c']."""
+    return [t for t in text.split(",") if t]
+
+
+def image_size(text):
+    """'WxH' → (W, H); an argparse type."""
+    import argparse
+
+    try:
+        width, height = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError("expected WIDTHxHEIGHT, e.g. 64x64: %r" % text)
+    if width <= 0 or height <= 0:
+        raise argparse.ArgumentTypeError("expected a positive size: %r" % text)
+    return width, height
+
+
+def add_mcrt_option(parser):
+    """--mcrt BINARY, default default_mcrt()."""
+    parser.add_argument("--mcrt", default=default_mcrt(),
+                        help="mcrt executable (default $MCRT, else build/mcrt)")
+
+
+def check_choices(kind, given, table, mcrt=None):
+    """ScriptError unless every name of `given` is one of the names of `table`, e.g.
+    check_choices("sampler", ["sobol"], "samplers")."""
+    known = names(table, mcrt=mcrt)
+    for name in given:
+        if name not in known:
+            raise ScriptError("unknown %s %s (one of %s)" % (kind, name, ", ".join(known)))
+
+
+# ----- charts ----------------------------------------------------------------------------------
+
+def pyplot():
+    """matplotlib.pyplot on the Agg backend (files only, no display)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def save_png(fig, path):
+    """Saves a figure as a small PNG: reduced to a 256-colour palette when Pillow is there."""
+    import io
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png")
+    try:
+        from PIL import Image
+        image = Image.open(io.BytesIO(buffer.getvalue())).convert("RGB")
+        image.quantize(256, method=Image.Quantize.MEDIANCUT).save(path, optimize=True)
+    except (ImportError, AttributeError):
+        Path(path).write_bytes(buffer.getvalue())

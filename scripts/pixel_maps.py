@@ -14,6 +14,7 @@
                           the largest spp.
 
 The reference is the one scripts/experiment.py uses (--reference auto, same cache) or a file.
+--estimator is a built-in name (`mcrt variants`) or an estimator file FILE.cl.
 
 Usage: scripts/pixel_maps.py SCENE [--estimator E] [--light-select S] [--sampler G]
            [--spp 4,16,64,256] [--repeats 4] [--width W --height H] [--reference auto|FILE]
@@ -25,10 +26,13 @@ import math
 import sys
 from pathlib import Path
 
-import numpy as np
+import mcrt_run
 
-import experiment
-from mcrt_exr import write_exr
+mcrt_run.require("numpy", "matplotlib")
+import numpy as np  # noqa: E402
+
+import experiment  # noqa: E402  (its reference, renders and list parsing)
+from mcrt_exr import write_exr  # noqa: E402
 
 
 def main():
@@ -39,7 +43,7 @@ def main():
     p.add_argument("--estimator", default="light-area")
     p.add_argument("--light-select", default="power")
     p.add_argument("--sampler", default="independent")
-    p.add_argument("--mis-heuristic", choices=["balance", "power"])
+    p.add_argument("--mis-heuristic", help="for the estimators that use one")
     p.add_argument("--spp", type=lambda t: experiment.number_list(t, int), default=[4, 16, 64, 256])
     p.add_argument("--repeats", type=int, default=4)
     p.add_argument("--seed", type=int, default=1)
@@ -48,15 +52,14 @@ def main():
     p.add_argument("--reference", default="auto")
     p.add_argument("--reference-spp", type=int, default=4096)
     p.add_argument("--reference-cache")
-    p.add_argument("--mcrt", default=str(experiment.ROOT / "build" / "mcrt"))
+    mcrt_run.add_mcrt_option(p)
     p.add_argument("--out", required=True)
     args = p.parse_args()
     if len(args.spp) < 2:
-        sys.exit("pixel_maps: error: --spp needs at least two levels for a slope")
-
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+        raise mcrt_run.ScriptError("--spp needs at least two levels for a slope")
+    # the scene, the binary and the variants, before any render
+    experiment.check_variants(args, [args.estimator], [args.light_select], [args.sampler])
+    plt = mcrt_run.pyplot()
 
     out = Path(args.out)
     scratch = out / "renders"
@@ -73,14 +76,12 @@ def main():
         sq = np.zeros(reference.shape[1:])
         for r in range(args.repeats):
             stem = str(scratch / ("r-%d-%d" % (spp, r)))
-            rgb, var, _, _, _ = experiment.run_mcrt(args, args.scene, stem, args.estimator,
-                                                    args.light_select, args.sampler,
-                                                    args.seed + r, spp=spp)
-            sq += ((rgb - reference) ** 2).mean(axis=0) / args.repeats
+            render = experiment.run_mcrt(args, args.scene, stem, args.estimator,
+                                         args.light_select, args.sampler, args.seed + r, spp=spp)
+            sq += ((render.rgb - reference) ** 2).mean(axis=0) / args.repeats
             if spp == levels[-1] and r == 0:
-                variance = var
-            for suffix in (".exr", ".json"):
-                Path(stem + suffix).unlink(missing_ok=True)
+                variance = render.variance
+            mcrt_run.remove_outputs(stem)
         log_mse.append(sq)
         print("pixel_maps: %d spp: RMSE %.4g" % (spp, math.sqrt(sq.mean())), file=sys.stderr)
 
@@ -98,8 +99,8 @@ def main():
               float_attributes={"spp": levels[-1]})
     write_exr(out / "convergence.exr", {"slope": slope, "mse": log_mse[-1]})
 
-    title = "%s, %s / %s / %s" % (Path(args.scene).name, args.estimator, args.light_select,
-                                  args.sampler)
+    title = "%s, %s / %s / %s" % (Path(args.scene).name, mcrt_run.estimator_label(args.estimator),
+                                  args.light_select, args.sampler)
     h, w = slope.shape
     size = (4.2, 3.6 * h / w + 0.5)
     fig, ax = plt.subplots(figsize=size, dpi=100)
@@ -113,7 +114,7 @@ def main():
     ax.set_xticks([])
     ax.set_yticks([])
     fig.tight_layout()
-    experiment.save_png(fig, out / "variance.png")
+    mcrt_run.save_png(fig, out / "variance.png")
     plt.close(fig)
 
     fig, ax = plt.subplots(figsize=size, dpi=100)
@@ -127,11 +128,11 @@ def main():
     ax.set_xticks([])
     ax.set_yticks([])
     fig.tight_layout()
-    experiment.save_png(fig, out / "convergence.png")
+    mcrt_run.save_png(fig, out / "convergence.png")
     plt.close(fig)
     print("pixel_maps: wrote %s (variance.exr/.png, convergence.exr/.png); median slope %.3f"
           % (out, float(np.nanmedian(slope))), file=sys.stderr)
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(mcrt_run.script_main(main))

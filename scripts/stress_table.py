@@ -19,58 +19,57 @@ and measures, from the K EXRs and stats JSONs:
 An RSE of "∞" means every render's image mean was 0 (no sample found light). Prints Markdown
 tables: RSE and RSE_t as an estimator × scene matrix, then every measurement.
 
-The EXRs are read with scripts/mcrt_exr.py (zlib and numpy: Debian 12 has no Python OpenEXR
-binding).
+The estimators are the direct-light ones of `mcrt variants` (those that use lights), the
+MIS ones once per heuristic, those that sample a light first; the selections are all of the
+table's. The EXRs are read with scripts/mcrt_exr.py (zlib and numpy: Debian 12 has no Python
+OpenEXR binding).
 
 Usage: scripts/stress_table.py [--mcrt build/mcrt] [--seeds 8] [--spp 64] [--size 128]
                                [--scenes NAME ...] [--keep DIR]
 """
 
 import argparse
-import json
 import math
 import statistics
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
-import numpy as np
+import mcrt_run
 
-from mcrt_exr import read_exr
+mcrt_run.require("numpy")
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = mcrt_run.ROOT
 SCENES = ["tiny-bright-light", "near-light", "grazing-light", "light-facing-away", "many-lights",
           "degenerate-emitters", "reflecting-emitters"]
 # Scenes about light selection: every selection; the others use power.
 SELECTION_SCENES = {"light-facing-away", "many-lights"}
-# (label, estimator, extra arguments); the direct-light estimators of DESIGN.md.
-ESTIMATORS = [("light-area", "light-area", []),
-              ("light-solid-angle", "light-solid-angle", []),
-              ("mis (balance)", "mis", ["--mis-heuristic", "balance"]),
-              ("mis (power)", "mis", ["--mis-heuristic", "power"]),
-              ("hemisphere-uniform", "hemisphere-uniform", []),
-              ("hemisphere-cosine", "hemisphere-cosine", [])]
-USES_LIGHTS = {"light-area", "light-solid-angle", "mis"}
+
+
+def estimators(mcrt):
+    """(label, estimator, extra arguments, samples a light) of each direct-light estimator of
+    the table of variants (DESIGN.md): those that sample a light first, an MIS one once per
+    heuristic, labelled "mis (balance)"."""
+    rows = []
+    for name in mcrt_run.names("estimators", uses="lights", mcrt=mcrt):
+        samples_light = mcrt_run.uses_light_select(name, mcrt)
+        if "mis-heuristic" in mcrt_run.estimator_uses(name, mcrt):
+            rows += [("%s (%s)" % (name, h), name, ["--mis-heuristic", h], samples_light)
+                     for h in mcrt_run.names("mis_heuristics", mcrt=mcrt)]
+        else:
+            rows.append((name, name, [], samples_light))
+    return sorted(rows, key=lambda row: not row[3])  # stable: the table's order otherwise
 
 
 # ----- measurements ----------------------------------------------------------------------------
 
 def render(mcrt, scene, estimator, extra, select, seed, args, scratch):
     stem = scratch / ("%s-%s%s-%s-%d" % (scene, estimator, "".join(extra[1:]), select, seed))
-    command = [str(mcrt), "render", str(ROOT / "scenes" / "stress" / (scene + ".gltf")),
-               "--out", str(stem) + ".exr", "--stats", str(stem) + ".json",
-               "--width", str(args.size), "--height", str(args.size), "--spp", str(args.spp),
-               "--estimator", estimator, "--light-select", select, "--seed", str(seed),
-               "--quiet", *extra]
-    done = subprocess.run(command, capture_output=True, text=True)
-    if done.returncode != 0:
-        sys.exit("%s\nexit %d: %s" % (" ".join(command), done.returncode, done.stderr.strip()))
-    stats = json.loads(Path(str(stem) + ".json").read_text())
-    exr = read_exr(str(stem) + ".exr")
-    rgb = np.stack([exr[c] for c in "RGB"]).astype(np.float64)
-    variance = np.stack([exr["variance." + c] for c in "RGB"]).astype(np.float64)
-    return rgb, variance, stats
+    r = mcrt_run.render(ROOT / "scenes" / "stress" / (scene + ".gltf"), stem,
+                        ["--width", args.size, "--height", args.size, "--spp", args.spp,
+                         "--estimator", estimator, "--light-select", select, "--seed", seed]
+                        + extra, mcrt=mcrt)
+    return r.rgb, r.variance, r.stats
 
 
 def measure(mcrt, scene, estimator, extra, select, args, scratch):
@@ -97,13 +96,16 @@ def percent(x):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--mcrt", default=str(ROOT / "build" / "mcrt"), help="mcrt executable")
+    mcrt_run.add_mcrt_option(parser)
     parser.add_argument("--seeds", type=int, default=8, help="independent renders K")
     parser.add_argument("--spp", type=int, default=64, help="samples per pixel")
     parser.add_argument("--size", type=int, default=128, help="image width and height")
     parser.add_argument("--scenes", nargs="+", default=SCENES, choices=SCENES)
     parser.add_argument("--keep", help="keep the EXRs and JSONs in this directory")
     args = parser.parse_args()
+    table = estimators(args.mcrt)
+    selections = mcrt_run.names("light_select", mcrt=args.mcrt)
+    order = ["power"] + [s for s in selections if s != "power"]  # the default first
 
     with tempfile.TemporaryDirectory(prefix="mcrt-stress-") as temporary:
         scratch = Path(args.keep) if args.keep else Path(temporary)
@@ -111,10 +113,10 @@ def main():
         rows = []  # (scene, label, select, measurement)
         for scene in args.scenes:
             scene_rows = []
-            for label, estimator, extra in ESTIMATORS:
+            for label, estimator, extra, samples_light in table:
                 selects = ["power"]
-                if scene in SELECTION_SCENES and estimator in USES_LIGHTS:
-                    selects = ["uniform", "power", "alias"]
+                if scene in SELECTION_SCENES and samples_light:
+                    selects = selections
                 for select in selects:
                     m = measure(args.mcrt, scene, estimator, extra, select, args, scratch)
                     scene_rows.append((scene, label, select, m))
@@ -132,8 +134,7 @@ def main():
     for _, label, select, _ in rows:
         if (label, select) not in keys:
             keys.append((label, select))
-    keys.sort(key=lambda k: ([e[0] for e in ESTIMATORS].index(k[0]),
-                             ["power", "uniform", "alias"].index(k[1])))
+    keys.sort(key=lambda k: ([e[0] for e in table].index(k[0]), order.index(k[1])))
     cells = {(s, l, sel): m for s, l, sel, m in rows}
     print("| estimator | " + " | ".join(args.scenes) + " |")
     print("|---|" + "---|" * len(args.scenes))
@@ -156,8 +157,8 @@ def main():
             scene, label, select, m["mean"], percent(m["rse"]), percent(m["rse_t"]),
             percent(m["px_rse"]), m["seconds"], m["nan"]))
     if any(m["nan"] for *_, m in rows):
-        sys.exit("non-finite samples: see the NaN column")
+        raise mcrt_run.ScriptError("non-finite samples: see the NaN column")
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(mcrt_run.script_main(main))

@@ -15,6 +15,7 @@
 #include "cl/cl_error.h"
 #include "cl/device.h"
 #include "cli/device_select.h"
+#include "render/memory_estimate.h"
 #include "cl/program.h"
 #include "common/error.h"
 #include "render/gpu_scene.h"
@@ -163,6 +164,18 @@ struct KindResult {
 
 int run_bench(const BenchOptions& o, const std::function<void(const std::string&)>& warn) {
     DeviceInfo device = select_device(o.device, warn);
+
+    check_host_memory("a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " bench",
+                      bench_host_bytes(o.width, o.height));
+    // One launch holds every ray (32 bytes) and its hit (16 bytes) on the device.
+    const DeviceInfo& chosen = device;
+    const uint64_t rays = uint64_t(o.width) * uint64_t(o.height);
+    if (rays * 32 > chosen.max_allocation || rays * 48 > chosen.global_memory)
+        throw RuntimeError("a " + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                           " bench needs " + std::to_string(rays * 48 >> 20) + " MiB on device " +
+                           std::to_string(o.device) + " (largest buffer " +
+                           std::to_string(chosen.max_allocation >> 20) + " MiB, memory " +
+                           std::to_string(chosen.global_memory >> 20) + " MiB)");
 
     Scene scene = load_gltf(o.scene, warn);
     if (scene.triangle_count() == 0) warn(o.scene + ": the scene has no triangles");

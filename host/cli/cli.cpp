@@ -7,9 +7,11 @@
 
 #include "bench/bench.h"
 #include "cl/device.h"
+#include "cl/no_device.h"
 #include "cli/integrate.h"
 #include "cli/messages.h"
 #include "cli/render_command.h"
+#include "cli/usage_errors.h"
 #include "cli/validators.h"
 #include "common/error.h"
 #include "render/variants.h"
@@ -19,7 +21,7 @@ namespace {
 
 int run_devices() {
     std::vector<DeviceInfo> devices = enumerate_devices(print_warning);
-    if (devices.empty()) throw RuntimeError("no OpenCL device found (is an ICD such as PoCL installed?)");
+    if (devices.empty()) throw RuntimeError(no_device_message());
     for (const DeviceInfo& d : devices) {
         std::printf("%d: %s [%s] — %s, %s, %u compute units, %.1f GiB, driver %s\n", d.index,
                     d.name.c_str(), d.type_name().c_str(), d.platform_name.c_str(),
@@ -73,7 +75,7 @@ int run_cli(int argc, char** argv) {
     } catch (const CLI::CallForAllHelp& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        std::cerr << "mcrt: error: " << e.what() << std::endl;
+        std::cerr << "mcrt: error: " << usage_error_message(app, e, argc, argv) << std::endl;
         return 2;
     }
 

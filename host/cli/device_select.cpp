@@ -2,6 +2,7 @@
 
 #include <set>
 
+#include "cl/no_device.h"
 #include "common/error.h"
 
 namespace mcrt {
@@ -9,7 +10,7 @@ namespace mcrt {
 std::vector<DeviceInfo> select_devices(const std::vector<std::string>& specs,
                                        const std::function<void(const std::string&)>& warn) {
     std::vector<DeviceInfo> all = enumerate_devices(warn);
-    if (all.empty()) throw RuntimeError("no OpenCL device found (is an ICD such as PoCL installed?)");
+    if (all.empty()) throw RuntimeError(no_device_message());
     if (specs.empty()) return {all.front()};
     std::set<int> chosen;
     for (const std::string& spec : specs) {

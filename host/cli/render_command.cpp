@@ -1,6 +1,8 @@
 #include "cli/render_command.h"
 
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -16,7 +18,12 @@
 #include "cli/validators.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
+#include "common/output_paths.h"
+#include "common/stop_signals.h"
+#include "common/value_limits.h"
 #include "image/image.h"
+#include "image/image_check.h"
+#include "render/memory_estimate.h"
 #include "render/render_program.h"
 #include "render/renderer.h"
 #include "render/variants.h"
@@ -42,20 +49,12 @@ struct InterruptGuard {
         sigaction(SIGTERM, &action, &old_term);
     }
     ~InterruptGuard() {
+        if (outputs_are_complete()) return;  // stop signals stay ignored: nothing left to save
         sigaction(SIGINT, &old_int, nullptr);
         sigaction(SIGTERM, &old_term, nullptr);
     }
     struct sigaction old_int {}, old_term {};
 };
-
-// An output's directory must exist before rendering starts, not after.
-void check_output_path(const std::string& path, const char* option) {
-    if (path.empty()) return;
-    std::filesystem::path dir = std::filesystem::path(path).parent_path();
-    if (!dir.empty() && !std::filesystem::is_directory(dir))
-        throw InputError(std::string(option) + " " + path + ": directory " + dir.string() +
-                         " does not exist");
-}
 
 glm::vec3 parse_sky(const std::string& text) {
     std::vector<float> v;
@@ -65,10 +64,11 @@ glm::vec3 parse_sky(const std::string& text) {
         try {
             size_t used = 0;
             float x = std::stof(item, &used);
-            if (used != item.size() || !std::isfinite(x) || x < 0) throw std::invalid_argument(item);
+            if (used != item.size() || !std::isfinite(x) || x < 0 || x > kMaxRadiance)
+                throw std::invalid_argument(item);
             v.push_back(x);
         } catch (const std::exception&) {
-            throw InputError("--sky " + text + ": expected R,G,B or one value, finite and >= 0");
+            throw InputError("--sky " + text + ": expected R,G,B or one value, each in [0, 1e15]");
         }
     }
     if (v.size() == 1) return glm::vec3(v[0]);
@@ -153,12 +153,16 @@ int run_render(const RenderOptions& o) {
     auto start = std::chrono::steady_clock::now();
     if (o.width * int64_t(o.height) * o.spp >= (int64_t(1) << 40))
         throw InputError("--width × --height × --spp is too large");
-    check_output_path(o.out, "--out");
-    check_output_path(o.png, "--png");
-    check_output_path(o.stats, "--stats");
+    const std::vector<OutputFile> outputs = {{"--out", o.out}, {"--png", o.png}, {"--stats", o.stats}};
+    std::vector<std::string> inputs = {o.scene};
+    if (!o.estimator_file.empty()) inputs.push_back(o.estimator_file);
+    check_outputs(outputs, inputs);
     RenderSettings settings = settings_of(o);
 
-    Scene scene = load_gltf(o.scene, print_warning);
+    Scene scene = load_gltf(o.scene, print_warning, &inputs);
+    check_outputs(outputs, inputs);  // its buffers too
+    check_host_memory("a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " render",
+                      render_host_bytes(o.width, o.height));
     if (scene.triangle_count() == 0) print_warning(o.scene + ": the scene has no triangles");
     unsigned uses = o.estimator_file.empty() ? estimator_variant(o.estimator).uses
                                              : kUserEstimatorUses;
@@ -201,6 +205,10 @@ int run_render(const RenderOptions& o) {
         print_warning("stopped by " + result.stopped_by + " after " + std::to_string(result.spp) +
                       " of " + std::to_string(o.spp) + " samples per pixel; writing those");
 
+    if (uint64_t bad = nonfinite_pixels(result.image))
+        throw RuntimeError(std::to_string(bad) + " pixels are not finite (radiance overflowed single "
+                           "precision); no image written");
+
     std::map<std::string, std::string> attributes = {
         {"mcrt.scene", o.scene},
         {"mcrt.estimator", o.estimator_file.empty() ? o.estimator : o.estimator_file},
@@ -217,12 +225,13 @@ int run_render(const RenderOptions& o) {
         write_atomically(o.stats, [&](const std::string& tmp) {
             std::ofstream out(tmp);
             out << j.dump(2) << "\n";
-            if (!out) throw RuntimeError(o.stats + ": cannot write");
+            if (!out) throw RuntimeError(o.stats + ": cannot write: " + std::strerror(errno ? errno : EIO));
         });
     }
     if (!o.quiet)
         std::cerr << "mcrt: wrote " << o.out << " (" << o.width << "x" << o.height << ", "
                   << result.spp << " spp, " << result.seconds_render << " s on the device)" << std::endl;
+    outputs_complete();
     return 0;
 }
 

@@ -61,7 +61,7 @@ void write_exr_file(const std::string& temporary, const std::string& path, const
     errno = 0;
     std::ofstream stream(temporary, std::ios::binary | std::ios::trunc);
     if (!stream) {
-        throw RuntimeError(path + ": cannot create " + temporary + ": " + std::strerror(errno));
+        throw RuntimeError(path + ": cannot create a temporary file: " + std::strerror(errno));
     }
     {
         Imf::StdOFStream exr_stream(stream, temporary.c_str());
@@ -71,7 +71,7 @@ void write_exr_file(const std::string& temporary, const std::string& path, const
         file.writePixels(image.height);
     }
     stream.close();
-    if (stream.fail()) throw RuntimeError(path + ": write failed: " + std::strerror(errno));
+    if (stream.fail()) throw RuntimeError(path + ": write failed: " + std::strerror(errno ? errno : EIO));
 }
 
 }  // namespace

@@ -63,7 +63,7 @@ void write_png(const std::string& path, const Image& image, float exposure) {
         file.write(encoded.data(), std::streamsize(encoded.size()));
         file.close();
         if (file.fail()) {
-            throw RuntimeError(path + ": cannot write PNG to " + temporary + ": " +
+            throw RuntimeError(path + ": cannot write PNG: " +
                                std::strerror(errno));
         }
     });

@@ -16,12 +16,19 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
+#include <array>
+#include <tuple>
 #include <limits>
 #include <map>
 #include <set>
+#include <unordered_map>
 #include <sstream>
 
 #include "common/error.h"
+#include "common/regular_file.h"
+#include "common/value_limits.h"
+#include "scene/gltf_types.h"
+#include "scene/json_guard.h"
 
 namespace mcrt {
 
@@ -32,6 +39,16 @@ constexpr double kMaxCoordinate = 1e30;                 // any position componen
 constexpr size_t kMaxTriangles = size_t(1) << 26;       // after instancing
 constexpr size_t kMaxNodeInstances = size_t(1) << 24;   // shared subtrees multiply
 constexpr size_t kMaxZeroBasedCount = size_t(1) << 24;  // sparse accessor without data
+constexpr size_t kMaxFileBytes = size_t(4) << 30;       // the scene file and each buffer
+// Beyond this magnitude float traversal may lose triangles: a floor quad of half-size S seen by
+// the bench camera renders for S ≤ 2e12, partly at 4e12, not at 7e12 (ROBUSTNESS.md "Silently
+// wrong input"); the bound keeps a factor 200 of margin. Such scenes load with one warning.
+constexpr double kWarnCoordinate = 1e10;
+// Extensions whose every effect on mcrt's scene model is implemented (or, for texture
+// transforms, void since textures are ignored): a file may require them ("Specifying
+// Extensions": a loader must refuse a file requiring any other).
+const std::set<std::string> kSupportedRequiredExtensions = {
+    "KHR_materials_emissive_strength", "KHR_mesh_quantization", "KHR_texture_transform"};
 
 // ---------------------------------------------------------------------------------------------
 // Diagnostics: errors name the file and the glTF element; warnings come once per kind.
@@ -82,6 +99,8 @@ bool all_finite(const std::vector<double>& values) {
     return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
 }
 
+double max_component(const glm::dvec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
+
 bool is_finite(const glm::dvec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
@@ -89,13 +108,6 @@ bool is_finite(const glm::dvec3& v) {
 // ---------------------------------------------------------------------------------------------
 // Reading the file
 // ---------------------------------------------------------------------------------------------
-
-// A GLB file starts with the magic "glTF" ("GLB File Format Specification", header).
-bool has_glb_magic(const std::string& path) {
-    std::ifstream file(path, std::ios::binary);
-    char magic[4] = {};
-    return file.read(magic, 4) && std::memcmp(magic, "glTF", 4) == 0;
-}
 
 bool has_glb_extension(const std::string& path) {
     std::string extension = std::filesystem::path(path).extension().string();
@@ -143,17 +155,78 @@ tinygltf::Model parse_model(const std::string& name, LoadCall load) {
     return model;
 }
 
-tinygltf::Model read_model(const std::string& path) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) {
-        throw InputError(path + ": cannot open: no such file");
+// File-system callbacks for loading from disk: only regular files below the scene's directory
+// (or reached from it by `../`) are read; tinygltf's fallback to the current directory is cut,
+// and every refusal (FIFO, directory, device, missing) is kept to name the real cause.
+struct DiskAccess {
+    std::string base_prefix;            // the scene's directory and "/"
+    std::vector<std::string> files_read;
+    std::string first_refusal;          // refusals of optional files (images) tinygltf drops
+};
+
+bool disk_file_exists(const std::string& path, void* user) {
+    // Claim the first candidate exists so the reader names why it cannot be read.
+    const auto* access = static_cast<const DiskAccess*>(user);
+    return path.compare(0, access->base_prefix.size(), access->base_prefix) == 0;
+}
+bool disk_file_read(std::vector<unsigned char>* out, std::string* error, const std::string& path,
+                    void* user) {
+    auto* access = static_cast<DiskAccess*>(user);
+    std::string why;
+    if (!read_regular_file(path, *out, why, kMaxFileBytes)) {
+        if (error) *error = why;
+        if (access->first_refusal.empty()) access->first_refusal = path + ": " + why;
+        return false;
     }
+    access->files_read.push_back(path);
+    return true;
+}
+std::string disk_path_unchanged(const std::string& path, void*) { return path; }
+bool disk_no_write(std::string* error, const std::string&, const std::vector<unsigned char>&,
+                   void*) {
+    if (error) *error = "not writable";
+    return false;
+}
+
+tinygltf::Model read_model(const std::string& path, std::vector<std::string>* files_read) {
+    std::vector<unsigned char> bytes;
+    std::string why;
+    if (!read_regular_file(path, bytes, why, kMaxFileBytes)) {
+        throw InputError(path + ": cannot open: " + why);
+    }
+    if (bytes.empty()) throw InputError(path + ": the file is empty");
+    const bool binary = (bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0) ||
+                        has_glb_extension(path);
+    check_json_nesting(path, bytes.data(), bytes.size(), binary);
+    {
+        const char* json = reinterpret_cast<const char*>(bytes.data());
+        size_t json_size = bytes.size();
+        if (!binary || glb_json_chunk(bytes.data(), bytes.size(), &json, &json_size))
+            check_gltf_property_types(path, reinterpret_cast<const unsigned char*>(json), json_size);
+    }
+
+    std::string base_dir = std::filesystem::path(path).parent_path().string();
+    if (base_dir.empty()) base_dir = ".";
+    DiskAccess access;
+    access.base_prefix = base_dir + "/";
     tinygltf::TinyGLTF loader = make_loader();
-    const bool binary = has_glb_magic(path) || has_glb_extension(path);
-    return parse_model(path, [&](tinygltf::Model* model, std::string* error, std::string* warning) {
-        return binary ? loader.LoadBinaryFromFile(model, error, warning, path)
-                      : loader.LoadASCIIFromFile(model, error, warning, path);
-    });
+    loader.SetFsCallbacks(tinygltf::FsCallbacks{disk_file_exists, disk_path_unchanged,
+                                                disk_file_read, disk_no_write, &access});
+    const auto length = static_cast<unsigned int>(bytes.size());
+    tinygltf::Model model =
+        parse_model(path, [&](tinygltf::Model* m, std::string* error, std::string* warning) {
+            return binary ? loader.LoadBinaryFromMemory(m, error, warning, bytes.data(), length,
+                                                        base_dir)
+                          : loader.LoadASCIIFromString(
+                                m, error, warning, reinterpret_cast<const char*>(bytes.data()),
+                                length, base_dir);
+        });
+    if (!access.first_refusal.empty()) throw InputError(path + ": " + access.first_refusal);
+    if (files_read) {
+        files_read->push_back(path);
+        files_read->insert(files_read->end(), access.files_read.begin(), access.files_read.end());
+    }
+    return model;
 }
 
 // File-system callbacks for loading from memory: no file exists, so a uri naming a file fails
@@ -182,12 +255,19 @@ tinygltf::Model read_model_from_memory(const std::string& name,
     const auto length = static_cast<unsigned int>(bytes.size());
     const bool binary =
         (bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0) || has_glb_extension(name);
-    return parse_model(name, [&](tinygltf::Model* model, std::string* error, std::string* warning) {
-        return binary ? loader.LoadBinaryFromMemory(model, error, warning, bytes.data(), length, "")
-                      : loader.LoadASCIIFromString(model, error, warning,
-                                                   reinterpret_cast<const char*>(bytes.data()),
-                                                   length, "");
-    });
+    check_json_nesting(name, bytes.data(), bytes.size(), binary);
+    const char* json = reinterpret_cast<const char*>(bytes.data());
+    size_t json_size = bytes.size();
+    if (!binary || glb_json_chunk(bytes.data(), bytes.size(), &json, &json_size))
+        check_gltf_property_types(name, reinterpret_cast<const unsigned char*>(json), json_size);
+    tinygltf::Model model =
+        parse_model(name, [&](tinygltf::Model* m, std::string* error, std::string* warning) {
+            return binary ? loader.LoadBinaryFromMemory(m, error, warning, bytes.data(), length, "")
+                          : loader.LoadASCIIFromString(m, error, warning,
+                                                       reinterpret_cast<const char*>(bytes.data()),
+                                                       length, "");
+        });
+    return model;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -504,7 +584,10 @@ class Importer {
         std::string element;  // who lists them, for errors
     };
     Roots root_nodes();
+    void check_asset();
+    void check_expansion(const Roots& roots);
     void traverse(const Roots& roots);
+    void merge_duplicate_emitters();
     glm::dmat4 local_transform(int node_index);
     void visit_node(int node_index, const glm::dmat4& world);
     void import_primitive(const tinygltf::Primitive& primitive, const std::string& element,
@@ -520,13 +603,174 @@ class Importer {
     Diagnostics& diag_;
     Scene scene_;
     std::map<int, uint32_t> material_slots_;  // glTF material index (−1: default) → Scene slot
+    double total_power_ = 0.0;                // of every emissive triangle instance, in double
+    double max_coordinate_ = 0.0;             // largest |component| of a world position
 };
 
 Scene Importer::import_default_scene(const std::string& path) {
     scene_.path = path;
+    check_asset();
     warn_unsupported_model_parts();
-    traverse(root_nodes());
+    const Roots roots = root_nodes();
+    check_expansion(roots);
+    traverse(roots);
+    // Light selection divides by shares of the total: it must be a float too.
+    if (!(total_power_ <= 0.5 * std::numeric_limits<float>::max())) {
+        diag_.fail("the emitters' summed power " + format_number(total_power_) +
+                   " overflows single precision (too many or too bright emitters)");
+    }
+    merge_duplicate_emitters();
+    if (max_coordinate_ > kWarnCoordinate) {
+        diag_.warn_once("coordinates", "coordinates up to " + format_number(max_coordinate_) +
+                                           " exceed " + format_number(kWarnCoordinate) +
+                                           ": float traversal may lose triangles");
+    }
     return std::move(scene_);
+}
+
+// "Asset": version 2.x, minVersion at most 2.0; "Specifying Extensions": every extension in
+// extensionsRequired must be supported.
+void Importer::check_asset() {
+    const std::string& version = model_.asset.version;
+    if (version.size() < 3 || version.compare(0, 2, "2.") != 0 ||
+        version.find_first_not_of("0123456789", 2) != std::string::npos) {
+        diag_.fail("asset.version \"" + version + "\" is not 2.x (glTF 2.0 is read)");
+    }
+    const std::string& min_version = model_.asset.minVersion;
+    if (!min_version.empty() && min_version != "2.0") {
+        diag_.fail("asset.minVersion \"" + min_version + "\" is newer than the 2.0 mcrt reads");
+    }
+    for (const std::string& extension : model_.extensionsRequired) {
+        if (!kSupportedRequiredExtensions.count(extension)) {
+            diag_.fail("extensionsRequired names " + extension + ", which mcrt does not implement");
+        }
+    }
+}
+
+// Node instances and triangles each root expands to, counted bottom-up per node (a shared
+// subtree once) before anything is expanded, so an exponential hierarchy is refused at once.
+// Triangle counts are upper bounds from the accessor counts; cycles are left to traverse().
+void Importer::check_expansion(const Roots& roots) {
+    const size_t n = model_.nodes.size();
+    constexpr double kUnknown = -1.0;
+    std::vector<double> instances(n, kUnknown), triangles(n, kUnknown);
+    std::vector<char> on_stack(n, 0);
+    auto mesh_triangles = [&](int mesh_index) {
+        double count = 0.0;
+        if (mesh_index < 0 || static_cast<size_t>(mesh_index) >= model_.meshes.size()) return count;
+        for (const tinygltf::Primitive& p : model_.meshes[static_cast<size_t>(mesh_index)].primitives) {
+            int accessor = p.indices;
+            if (accessor == -1) {
+                const auto position = p.attributes.find("POSITION");
+                accessor = position == p.attributes.end() ? -1 : position->second;
+            }
+            if (accessor >= 0 && static_cast<size_t>(accessor) < model_.accessors.size())
+                count += static_cast<double>(model_.accessors[static_cast<size_t>(accessor)].count);
+        }
+        return count;  // ≥ the triangles of any mode
+    };
+    struct Frame {
+        int node;
+        size_t next_child;
+    };
+    std::vector<Frame> stack;
+    auto valid = [&](int node) { return node >= 0 && static_cast<size_t>(node) < n; };
+    double total_instances = 0.0, total_triangles = 0.0;
+    for (int root : roots.nodes) {
+        if (!valid(root)) continue;  // traverse() names it
+        if (instances[static_cast<size_t>(root)] == kUnknown) {
+            stack.push_back(Frame{root, 0});
+            on_stack[static_cast<size_t>(root)] = 1;
+            while (!stack.empty()) {
+                Frame& top = stack.back();
+                const auto& children = model_.nodes[static_cast<size_t>(top.node)].children;
+                if (top.next_child < children.size()) {
+                    const int child = children[top.next_child++];
+                    if (!valid(child) || on_stack[static_cast<size_t>(child)] ||
+                        instances[static_cast<size_t>(child)] != kUnknown)
+                        continue;  // invalid or cyclic: traverse() names it
+                    on_stack[static_cast<size_t>(child)] = 1;
+                    stack.push_back(Frame{child, 0});
+                    continue;
+                }
+                const size_t node = static_cast<size_t>(top.node);
+                double i = 1.0, t = mesh_triangles(model_.nodes[node].mesh);
+                for (int child : children) {
+                    if (!valid(child) || instances[static_cast<size_t>(child)] == kUnknown) continue;
+                    i += instances[static_cast<size_t>(child)];
+                    t += triangles[static_cast<size_t>(child)];
+                }
+                instances[node] = i;
+                triangles[node] = t;
+                on_stack[node] = 0;
+                stack.pop_back();
+            }
+        }
+        total_instances += instances[static_cast<size_t>(root)];
+        total_triangles += triangles[static_cast<size_t>(root)];
+    }
+    if (total_instances > static_cast<double>(kMaxNodeInstances)) {
+        diag_.fail("the node hierarchy expands to " + format_number(total_instances) +
+                   " node instances, more than " + std::to_string(kMaxNodeInstances));
+    }
+    if (total_triangles > 3.0 * static_cast<double>(kMaxTriangles)) {
+        diag_.fail("the node hierarchy expands to up to " + format_number(total_triangles / 3.0) +
+                   " triangles, more than " + std::to_string(kMaxTriangles));
+    }
+}
+
+// The same emissive triangle twice (same material, same corners in the same winding; either
+// winding when double-sided) is one surface a ray hits once, but light sampling would count it
+// twice: keep the first, drop the copies, warn once.
+void Importer::merge_duplicate_emitters() {
+    struct Key {
+        std::array<float, 9> corners;
+        uint32_t material;
+        bool operator==(const Key& o) const { return corners == o.corners && material == o.material; }
+    };
+    struct KeyHash {
+        size_t operator()(const Key& k) const {
+            size_t h = std::hash<uint32_t>()(k.material);
+            for (float f : k.corners) h = h * 1000003u ^ std::hash<float>()(f);
+            return h;
+        }
+    };
+    auto key_of = [&](size_t t) {
+        std::array<glm::vec3, 3> v = {scene_.positions[3 * t], scene_.positions[3 * t + 1],
+                                      scene_.positions[3 * t + 2]};
+        auto less = [](const glm::vec3& a, const glm::vec3& b) {
+            return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+        };
+        const uint32_t material = scene_.triangle_material[t];
+        if (scene_.materials[material].double_sided) {
+            std::sort(v.begin(), v.end(), less);
+        } else {  // rotate the smallest corner first: the winding is kept
+            const size_t first = static_cast<size_t>(std::min_element(v.begin(), v.end(), less) - v.begin());
+            std::rotate(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(first), v.end());
+        }
+        Key key{{v[0].x, v[0].y, v[0].z, v[1].x, v[1].y, v[1].z, v[2].x, v[2].y, v[2].z}, material};
+        return key;
+    };
+    std::unordered_map<Key, size_t, KeyHash> seen;
+    std::vector<char> drop(scene_.triangle_count(), 0);
+    size_t dropped = 0;
+    for (size_t t = 0; t < scene_.triangle_count(); ++t) {
+        if (!(luminance(scene_.materials[scene_.triangle_material[t]].emission) > 0.0f)) continue;
+        if (!seen.emplace(key_of(t), t).second) drop[t] = 1, ++dropped;
+    }
+    if (dropped == 0) return;
+    size_t kept = 0;
+    for (size_t t = 0; t < scene_.triangle_count(); ++t) {
+        if (drop[t]) continue;
+        for (int c = 0; c < 3; ++c) scene_.positions[3 * kept + c] = scene_.positions[3 * t + c];
+        scene_.triangle_material[kept++] = scene_.triangle_material[t];
+    }
+    scene_.positions.resize(3 * kept);
+    scene_.triangle_material.resize(kept);
+    diag_.warn_once("duplicate-emitters",
+                    std::to_string(dropped) +
+                        " emissive triangle(s) repeat another exactly (same corners and material); "
+                        "the copies are dropped so that each surface emits once");
 }
 
 // The `scene` property's scene, else scene 0 ("Scenes"); a file without scenes renders its
@@ -619,7 +863,18 @@ glm::dmat4 Importer::local_transform(int node_index) {
     check(node.rotation, 4, "rotation");
     check(node.scale, 3, "scale");
 
-    if (!node.matrix.empty()) return glm::make_mat4(node.matrix.data());
+    if (!node.matrix.empty()) {
+        const glm::dmat4 m = glm::make_mat4(node.matrix.data());
+        // "Transformations": a matrix must decompose into T·R·S, so its last row is 0 0 0 1.
+        if (m[0][3] != 0.0 || m[1][3] != 0.0 || m[2][3] != 0.0 || m[3][3] != 1.0) {
+            diag_.fail(element, "matrix is projective (its last row is not 0 0 0 1)");
+        }
+        if (glm::determinant(glm::dmat3(m)) == 0.0) {
+            diag_.warn_once("singular", element + ": transform is singular (zero scale): its "
+                                                  "geometry collapses and is degenerate");
+        }
+        return m;
+    }
 
     glm::dmat4 transform(1.0);
     if (!node.translation.empty())
@@ -632,6 +887,10 @@ glm::dmat4 Importer::local_transform(int node_index) {
         transform *= glm::mat4_cast(q / length);
     }
     if (!node.scale.empty()) transform = glm::scale(transform, glm::make_vec3(node.scale.data()));
+    if (glm::determinant(glm::dmat3(transform)) == 0.0) {
+        diag_.warn_once("singular", element + ": transform is singular (zero scale): its "
+                                              "geometry collapses and is degenerate");
+    }
     return transform;
 }
 
@@ -686,12 +945,17 @@ void Importer::import_primitive(const tinygltf::Primitive& primitive, const std:
             diag_.fail(node_element, "transformed position of " + element +
                                          " is not finite or exceeds 1e30 in magnitude");
         }
+        max_coordinate_ = std::max(max_coordinate_, max_component(glm::abs(p)));
     }
     std::vector<uint32_t> ids(positions.size());
     if (primitive.indices != -1) {
         ids = read_indices(model_, primitive.indices, positions.size(), element, diag_);
     } else {
         for (size_t v = 0; v < ids.size(); ++v) ids[v] = static_cast<uint32_t>(v);
+    }
+    if (mode == TINYGLTF_MODE_TRIANGLES && ids.size() % 3 != 0) {
+        diag_.fail(element, std::to_string(ids.size()) + (primitive.indices != -1 ? " indices" : " vertices") +
+                                " are not a multiple of 3 (mode TRIANGLES)");
     }
     const std::vector<uint32_t> corners = triangle_list(mode, ids);
     const size_t triangles = corners.size() / 3;
@@ -719,6 +983,7 @@ void Importer::import_primitive(const tinygltf::Primitive& primitive, const std:
                                         format_number(power) +
                                         " overflows single precision (emission × area too large)");
             }
+            total_power_ += power;
         }
         scene_.positions.push_back(glm::vec3(positions[a]));
         scene_.positions.push_back(glm::vec3(positions[mirrored ? c : b]));
@@ -793,13 +1058,25 @@ Material Importer::convert_material(int material_index, const std::string& refer
 
     Material material;
     material.name = source.name.empty() ? element : source.name;
-    material.albedo = glm::vec3(glm::dvec3(base[0], base[1], base[2]));
+    glm::dvec3 albedo(base[0], base[1], base[2]);
+    if (max_component(albedo) > 1.0) {
+        // An albedo above 1 reflects more than arrives: energy from nothing.
+        diag_.warn_once("albedo", element + ": baseColorFactor " + format_number(max_component(albedo)) +
+                                      " is above 1; factors are clamped to [0, 1]");
+        albedo = glm::min(albedo, glm::dvec3(1.0));
+    }
+    material.albedo = glm::vec3(albedo);
     if (!emissive.empty()) {
         const glm::dvec3 Le =
             glm::dvec3(emissive[0], emissive[1], emissive[2]) * emissive_strength(source, element);
         material.emission = glm::vec3(Le);
         if (!is_finite(glm::dvec3(material.emission))) {
             diag_.fail(element, "emission overflows single precision");
+        }
+        if (max_component(Le) > kMaxRadiance) {
+            diag_.fail(element, "emission " + format_number(max_component(Le)) + " exceeds " +
+                                    format_number(kMaxRadiance) +
+                                    ", beyond which a pixel's sums overflow single precision");
         }
     }
     material.double_sided = source.doubleSided;
@@ -853,8 +1130,9 @@ void Importer::warn_unsupported_model_parts() {
 
 }  // namespace
 
-Scene load_gltf(const std::string& path, const WarningSink& warn) {
-    const tinygltf::Model model = read_model(path);
+Scene load_gltf(const std::string& path, const WarningSink& warn,
+                std::vector<std::string>* files_read) {
+    const tinygltf::Model model = read_model(path, files_read);
     Diagnostics diag(path, warn);
     return Importer(model, diag).import_default_scene(path);
 }

@@ -1,0 +1,17 @@
+// Test hooks: let the end-to-end tests stop mcrt at a known point (writing an output, after the
+// outputs are complete) without timing guesses. Inert unless MCRT_TEST_PAUSE names the point.
+#pragma once
+
+namespace mcrt {
+
+// When MCRT_TEST_PAUSE equals `point`, writes "mcrt: test: paused at POINT" to stderr and sleeps
+// MCRT_TEST_PAUSE_SECONDS (default 20) seconds, signals notwithstanding, or until the file
+// MCRT_TEST_PAUSE_UNTIL exists. Otherwise nothing. Points: "before-write" and "write" (each
+// output, before its temporary exists and after it is written), "exit" (after the command).
+void test_pause(const char* point);
+
+// True when MCRT_TEST_NO_TMPFILE is set: outputs take the named-temporary path that file systems
+// without O_TMPFILE get.
+bool test_no_tmpfile();
+
+}  // namespace mcrt

@@ -1,0 +1,286 @@
+// Outputs that destroy, signals and pipes, images too large (issue 12, classes 1, 5 and 6): no
+// output path is replaced unless it is a regular file that is no other output and no input, no
+// temporary file survives any way the process can end, and a closed stderr pipe or a late
+// SIGTERM does not lose the image. The tests never point an output at a system file: FIFOs,
+// directories and devices are made in a temporary directory (mkfifo needs no privilege).
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+
+#include "common/atomic_file.h"
+#include "common/output_paths.h"
+#include "common/error.h"
+#include "hostile_support.h"
+#include "image/image.h"
+#include "process_support.h"
+#include "render/memory_estimate.h"
+#include "test_support.h"
+
+using namespace mcrt;
+using namespace mcrt::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kCornell = std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf";
+
+std::vector<std::string> small_render(const std::string& out) {
+    return {"render", kCornell, "--width", "16", "--height", "12", "--spp", "16", "--quiet",
+            "--out", out};
+}
+
+std::vector<std::string> with(std::vector<std::string> args, std::initializer_list<std::string> more) {
+    args.insert(args.end(), more);
+    return args;
+}
+
+// Every name in `dir`, hidden ones included.
+std::vector<std::string> names_in(const fs::path& dir) {
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+}
+
+void require_one_error(const ProcessResult& r, int status, const std::string& needle) {
+    INFO("stderr: " << r.err);
+    REQUIRE_FALSE(r.timed_out);
+    CHECK(r.exit_code == status);
+    CHECK(lines_starting_with(r.err, "mcrt: error:").size() == 1);
+    CHECK(r.err.find(needle) != std::string::npos);
+}
+
+}  // namespace
+
+TEST_CASE("an existing output that is not a regular file is refused before rendering",
+          "[outputs][hostile]") {
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    const std::string fifo = dir / "fifo", directory = dir / "directory";
+    REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+    fs::create_directory(directory);
+    for (const std::string option : {"--out", "--png", "--stats"}) {
+        for (const std::string& target : {fifo, directory}) {
+            DYNAMIC_SECTION(option << " " << fs::path(target).filename().string()) {
+                std::vector<std::string> args = small_render(option == "--out" ? target : dir / "a.exr");
+                if (option != "--out") args = with(args, {option, target});
+                const ProcessResult r = run_process(MCRT_EXE, args, logs.path(), 60);
+                require_one_error(r, 2, "refusing to replace it");
+                struct stat st {};
+                REQUIRE(::stat(fifo.c_str(), &st) == 0);
+                CHECK(S_ISFIFO(st.st_mode));
+                CHECK(fs::is_directory(directory));
+                CHECK_FALSE(fs::exists(dir / "a.exr"));
+            }
+        }
+    }
+}
+
+TEST_CASE("write_atomically never replaces what is not a regular file", "[outputs][hostile]") {
+    TempDir dir("mcrt-hostile");
+    const std::string fifo = dir / "fifo";
+    REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+    CHECK_THROWS_AS(write_atomically(fifo, [](const std::string& t) { write_text(t, "x"); }), InputError);
+    struct stat st {};
+    REQUIRE(::stat(fifo.c_str(), &st) == 0);
+    CHECK(S_ISFIFO(st.st_mode));
+    CHECK(names_in(dir.path()) == std::vector<std::string>{"fifo"});
+}
+
+TEST_CASE("two outputs that are the same file are refused", "[outputs][hostile]") {
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    const std::string exr = dir / "a.exr";
+    SECTION("the same name") {
+        const ProcessResult r = run_process(MCRT_EXE, with(small_render(exr), {"--png", exr}), logs.path(), 60);
+        require_one_error(r, 2, "the same file as --out");
+        CHECK_FALSE(fs::exists(exr));
+    }
+    SECTION("the same name written differently") {
+        const ProcessResult r = run_process(
+            MCRT_EXE, with(small_render(exr), {"--stats", dir.path().string() + "/./a.exr"}), logs.path(), 60);
+        require_one_error(r, 2, "the same file as --out");
+    }
+    SECTION("a hard link and a symbolic link to an existing output") {
+        write_text(exr, "precious");
+        fs::create_hard_link(exr, dir / "hard.json");
+        fs::create_symlink(exr, dir / "soft.png");
+        for (const auto& [option, other] :
+             std::vector<std::pair<std::string, std::string>>{{"--stats", dir / "hard.json"},
+                                                              {"--png", dir / "soft.png"}}) {
+            const ProcessResult r = run_process(MCRT_EXE, with(small_render(exr), {option, other}), logs.path(), 60);
+            require_one_error(r, 2, "the same file as --out");
+            CHECK(read_whole_file(exr) == "precious");
+        }
+    }
+}
+
+TEST_CASE("an output that is an input (the scene or its buffer) is refused", "[outputs][hostile]") {
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    const fs::path source = fs::path(kCornell).parent_path();
+    fs::copy_file(kCornell, dir / "box.gltf");
+    // The .gltf names its buffer: copy it under the same name.
+    fs::copy_file(source / "CornellBox-Original.bin", dir / "CornellBox-Original.bin");
+    const std::string scene = read_whole_file(dir / "box.gltf");
+    const std::string buffer = read_whole_file(dir / "CornellBox-Original.bin");
+    auto args = [&](const std::string& out) {
+        return std::vector<std::string>{"render", dir / "box.gltf", "--width", "8", "--height", "8",
+                                        "--spp", "16", "--quiet", "--out", out};
+    };
+    require_one_error(run_process(MCRT_EXE, args(dir / "box.gltf"), logs.path(), 60), 2, "is the input");
+    require_one_error(run_process(MCRT_EXE, with(args(dir / "a.exr"), {"--png", dir / "CornellBox-Original.bin"}),
+                                  logs.path(), 60),
+                      2, "is the input");
+    CHECK(read_whole_file(dir / "box.gltf") == scene);
+    CHECK(read_whole_file(dir / "CornellBox-Original.bin") == buffer);
+    CHECK_FALSE(fs::exists(dir / "a.exr"));
+}
+
+TEST_CASE("a write that fails names the reason, exits 1 and leaves no temporary file",
+          "[outputs][hostile]") {
+    // A file-size limit set on mcrt just before it writes (the kernel build needs files of its
+    // own) fails the EXR's write(2) as a full disk does: mcrt ignores SIGXFSZ, so the write
+    // returns EFBIG and its reason is named.
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    for (const std::string tmpfile : {"", "MCRT_TEST_NO_TMPFILE=1"}) {
+        DYNAMIC_SECTION("temporary " << (tmpfile.empty() ? "unnamed" : "named")) {
+            std::vector<std::string> args = {MCRT_EXE, "render", kCornell, "--width", "64", "--height", "48",
+                                             "--spp", "16", "--quiet", "--out", dir / "a.exr"};
+            std::vector<std::string> env = {"MCRT_TEST_PAUSE=before-write",
+                                            "MCRT_TEST_PAUSE_UNTIL=" + (logs / "go")};
+            if (!tmpfile.empty()) env.push_back(tmpfile);
+            std::filesystem::remove(logs / "go");
+            Child child(args, env, logs / "log");
+            REQUIRE(child.wait_for_text("paused at before-write", 60));
+            const struct rlimit limit = {4096, 4096};
+            REQUIRE(::prlimit(child.pid(), RLIMIT_FSIZE, &limit, nullptr) == 0);
+            write_text(logs / "go", "");
+            const int status = child.wait(60);
+            const std::string err = child.output();
+            INFO(err);
+            REQUIRE(WIFEXITED(status));
+            CHECK(WEXITSTATUS(status) == 1);
+            CHECK(lines_starting_with(err, "mcrt: error:").size() == 1);
+            CHECK(err.find("File too large") != std::string::npos);
+            CHECK(names_in(dir.path()).empty());
+        }
+    }
+}
+
+TEST_CASE("SIGKILL while an output is written leaves no temporary file", "[outputs][signals][hostile]") {
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    const std::string exr = dir / "a.exr";
+    std::vector<std::string> args = small_render(exr);
+    args.insert(args.begin(), MCRT_EXE);
+    {
+        Child child(args, {"MCRT_TEST_PAUSE=write"}, logs / "log1");
+        REQUIRE(child.wait_for_text("paused at write", 60));
+        child.signal(SIGKILL);
+        const int status = child.wait(30);
+        CHECK(WIFSIGNALED(status));
+        CHECK(names_in(dir.path()).empty());
+    }
+    SECTION("named temporary: the next write sweeps the dead process's file") {
+        Child child(args, {"MCRT_TEST_PAUSE=write", "MCRT_TEST_NO_TMPFILE=1"}, logs / "log2");
+        REQUIRE(child.wait_for_text("paused at write", 60));
+        child.signal(SIGKILL);
+        child.wait(30);
+        const std::vector<std::string> left = names_in(dir.path());
+        REQUIRE(left.size() == 1);
+        CHECK(left[0].rfind(".a.exr.tmp-", 0) == 0);
+        const ProcessResult r = run_process(MCRT_EXE, small_render(exr), logs.path(), 60);
+        CHECK(r.exit_code == 0);
+        CHECK(names_in(dir.path()) == std::vector<std::string>{"a.exr"});
+    }
+}
+
+TEST_CASE("a second SIGINT while an output is written leaves no temporary file",
+          "[outputs][signals][hostile]") {
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    std::vector<std::string> args = with(small_render(dir / "a.exr"), {"--stats", dir / "a.json"});
+    args.insert(args.begin(), MCRT_EXE);
+    Child child(args, {"MCRT_TEST_PAUSE=write"}, logs / "log");
+    REQUIRE(child.wait_for_text("paused at write", 60));
+    child.signal(SIGINT);  // asks to stop: the render is done, writing goes on
+    REQUIRE(child.wait_handler_reset(SIGINT, 30));
+    child.signal(SIGINT);  // the second one ends the process at once (SA_RESETHAND)
+    const int status = child.wait(30);
+    INFO(child.output());
+    CHECK(WIFSIGNALED(status));
+    CHECK(names_in(dir.path()).empty());
+}
+
+TEST_CASE("a closed stderr pipe does not kill mcrt: the image is still written",
+          "[signals][hostile]") {
+    // `mcrt render … 2>&1 | head -c 10` with head gone.
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    std::vector<std::string> args = {MCRT_EXE, "render", kCornell, "--width", "16", "--height", "12",
+                                     "--spp", "16", "--out", dir / "a.exr"};
+    Child child(args, {}, logs / "log", true);
+    const int status = child.wait(60);
+    REQUIRE_FALSE(child.timed_out());
+    CHECK_FALSE(WIFSIGNALED(status));
+    CHECK(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 0);
+    const Image img = read_exr(dir / "a.exr");
+    CHECK(img.width == 16);
+}
+
+TEST_CASE("SIGTERM after the outputs are complete exits 0", "[signals][hostile]") {
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    std::vector<std::string> args = small_render(dir / "a.exr");
+    args.insert(args.begin(), MCRT_EXE);
+    Child child(args, {"MCRT_TEST_PAUSE=exit", "MCRT_TEST_PAUSE_SECONDS=2"}, logs / "log");
+    REQUIRE(child.wait_for_text("paused at exit", 60));
+    child.signal(SIGTERM);
+    child.signal(SIGINT);
+    const int status = child.wait(30);
+    INFO(child.output());
+    CHECK_FALSE(WIFSIGNALED(status));
+    CHECK(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 0);
+    CHECK(read_exr(dir / "a.exr").width == 16);
+}
+
+TEST_CASE("error messages name the real cause", "[cli][hostile]") {
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    SECTION("an unknown subcommand names itself") {
+        const ProcessResult r = run_process(MCRT_EXE, {"frobnicate"}, logs.path(), 30);
+        require_one_error(r, 2, "unknown subcommand 'frobnicate'");
+    }
+    SECTION("an unusable PoCL cache directory is not 'no device'") {
+        write_text(dir / "file", "x");
+        std::string command = "POCL_CACHE_DIR='" + (dir / "file") + "/pocl' exec '" + MCRT_EXE + "' devices";
+        const ProcessResult r = run_process("/bin/sh", {"-c", command}, logs.path(), 30);
+        if (r.exit_code == 0) skip_test("this OpenCL platform does not need PoCL's cache directory");
+        require_one_error(r, 1, "kernel cache directory");
+    }
+}
+
+TEST_CASE("an image too large for host memory is refused before rendering", "[memory][hostile]") {
+    const uint64_t need = render_host_bytes(16384, 16384);
+    CHECK(need > uint64_t(16384) * 16384 * 120);  // accumulator doubles and image floats at least
+    CHECK_THROWS_AS(check_host_memory("x", ~uint64_t(0) / 2), RuntimeError);
+    CHECK_NOTHROW(check_host_memory("x", 1));
+    const uint64_t available = available_host_bytes();
+    if (available == 0 || available >= need) skip_test("this machine has room for a 16384² render");
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    const ProcessResult r = run_process(
+        MCRT_EXE, {"render", kCornell, "--width", "16384", "--height", "16384", "--spp", "1", "--quiet",
+                   "--out", dir / "a.exr"}, logs.path(), 60);
+    require_one_error(r, 1, "of host memory");
+    CHECK(names_in(dir.path()).empty());
+    const ProcessResult b = run_process(
+        MCRT_EXE, {"bench", kCornell, "--width", "16384", "--height", "16384", "--repeats", "1"}, logs.path(), 60);
+    require_one_error(b, 1, "memory");
+}
