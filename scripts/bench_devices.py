@@ -2,31 +2,27 @@
 """Multi-device scheduling figures: throughput with each device alone and with all together,
 each device's share of the samples against its measured speed, and a simulated slow device.
 
-Usage: scripts/bench_devices.py [--scene S] [--size WxH] [--spp N]
+Usage: scripts/bench_devices.py [--scene S] [--size WxH] [--spp N] [--mcrt BINARY]
 Runs build/mcrt with POCL_DEVICES="pthread basic" (two PoCL devices on the same cores) and
 prints Markdown tables. MCRT_SLOW_DEVICE=D:F makes device D sleep (F-1)x its kernel time after
-each launch, i.e. behave F times slower.
+each launch, i.e. behave F times slower. Only the standard library.
 """
 import argparse
-import json
-import os
-import subprocess
+import sys
 import tempfile
+from pathlib import Path
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+import mcrt_run
 
 
 def render(args, devices, env_extra, out_dir):
-    stats = os.path.join(out_dir, "stats.json")
-    cmd = [os.path.join(ROOT, "build", "mcrt"), "render", args.scene, "--out",
-           os.path.join(out_dir, "image.exr"), "--stats", stats, "--spp", str(args.spp),
-           "--width", str(args.width), "--height", str(args.height), "--quiet"]
+    """The stats JSON of one render on `devices` (indices for --device)."""
+    options = ["--spp", args.spp, "--width", args.size[0], "--height", args.size[1]]
     for d in devices:
-        cmd += ["--device", d]
-    env = dict(os.environ, POCL_DEVICES="pthread basic", **env_extra)
-    subprocess.run(cmd, check=True, env=env)
-    with open(stats) as f:
-        return json.load(f)
+        options += ["--device", d]
+    return mcrt_run.render(args.scene, Path(out_dir) / "image", options, mcrt=args.mcrt,
+                           env=dict(POCL_DEVICES="pthread basic", **env_extra),
+                           read_image=False).stats
 
 
 def row(label, s):
@@ -42,11 +38,11 @@ def row(label, s):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--scene", default=os.path.join(ROOT, "scenes/cornell/CornellBox-Original.gltf"))
-    p.add_argument("--size", default="512x512")
+    p.add_argument("--scene", default=str(mcrt_run.ROOT / "scenes/cornell/CornellBox-Original.gltf"))
+    p.add_argument("--size", type=mcrt_run.image_size, default="512x512")
     p.add_argument("--spp", type=int, default=64)
+    mcrt_run.add_mcrt_option(p)
     args = p.parse_args()
-    args.width, args.height = (int(v) for v in args.size.split("x"))
     with tempfile.TemporaryDirectory() as out:
         render(args, ["0"], {}, out)  # warm the kernel caches
         render(args, ["1"], {}, out)
@@ -62,4 +58,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(mcrt_run.script_main(main))

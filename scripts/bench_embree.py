@@ -7,16 +7,17 @@ Runs build/mcrt bench on each scene R times (scenes taken in turn, round by roun
 change in the machine's load spreads over all of them) and prints one Markdown row per scene
 and ray kind: medians over the rounds of mcrt's and Embree's Mrays/s and of the ratio measured
 within each run (both tracers alternate launch by launch inside a run). Needs an mcrt built with
-Embree (scripts/setup installs libembree-dev). Uses /usr/bin/python3 and the standard library.
+Embree (scripts/setup installs libembree-dev). Only the standard library.
 """
 import argparse
 import json
 import os
 import statistics
-import subprocess
+import sys
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SHARED = os.path.join(os.path.dirname(ROOT), "shared", "scenes")
+import mcrt_run
+
+SHARED = os.path.join(os.path.dirname(mcrt_run.ROOT), "shared", "scenes")
 SCENES = ["sponza/crytek-sponza.gltf", "stanford/dragon_vrip_res2.glb",
           "lights/modern-hall/modern-hall.gltf"]
 KINDS = ["primary", "shadow", "ambient"]
@@ -28,25 +29,29 @@ def load_average():
 
 
 def bench(scene, args, extra):
-    cmd = [args.mcrt, "bench", scene, "--json", "--width",
-           str(args.width), "--height", str(args.height), "--repeats", str(args.repeats)] + extra
-    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
-    lines = [json.loads(line) for line in out.splitlines() if line.strip()]
+    """`mcrt bench SCENE --json`: ray kind → its JSON line."""
+    cmd = [mcrt_run.mcrt_binary(args.mcrt), "bench", scene, "--json", "--width", args.width,
+           "--height", args.height, "--repeats", args.repeats] + extra
+    out = mcrt_run.run(cmd).stdout
+    try:
+        lines = [json.loads(line) for line in out.splitlines() if line.strip()]
+    except ValueError as e:
+        raise mcrt_run.ScriptError("mcrt bench %s: not JSON lines: %s" % (scene, e))
     if any("embree_mrays_per_s" not in j for j in lines):
-        raise SystemExit(f"bench_embree.py: {args.mcrt} was built without Embree")
+        raise mcrt_run.ScriptError(f"{args.mcrt} was built without Embree")
     return {j["rays"]: j for j in lines}
 
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--rounds", type=int, default=3)
-    p.add_argument("--size", default="1024x1024")
+    p.add_argument("--size", type=mcrt_run.image_size, default="1024x1024")
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--scenes", nargs="+", default=[os.path.join(SHARED, s) for s in SCENES])
-    p.add_argument("--mcrt", default=os.path.join(ROOT, "build", "mcrt"), help="the binary")
+    mcrt_run.add_mcrt_option(p)
     p.add_argument("extra", nargs="*", help="further `mcrt bench` options, after --")
     args = p.parse_args()
-    args.width, args.height = (int(v) for v in args.size.split("x"))
+    args.width, args.height = args.size
 
     runs = {s: [] for s in args.scenes}
     loads = [load_average()]
@@ -84,4 +89,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(mcrt_run.script_main(main))
