@@ -11,16 +11,14 @@ import csv
 import io
 import math
 import os
-import subprocess
 import sys
 
-import matplotlib
+import mcrt_run
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+mcrt_run.require("numpy", "matplotlib")
 import numpy as np  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = str(mcrt_run.ROOT)
 FLOOR = 1e-9  # the cosine estimator's error is float rounding (~1e-7) or exactly 0: plotted at max(·, FLOOR)
 STYLE = {"uniform": "tab:blue", "cosine": "tab:green", "fibonacci": "tab:red"}
 
@@ -44,7 +42,7 @@ def fitted_slope(n, y, n_min):
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--csv", help="read this CSV instead of running mcrt")
-    parser.add_argument("--mcrt", default=os.path.join(ROOT, "build", "mcrt"), help="mcrt executable")
+    mcrt_run.add_mcrt_option(parser)
     parser.add_argument("--repeats", type=int, default=32, help="--repeats passed to mcrt integrate")
     parser.add_argument("--seed", type=int, default=0, help="--seed passed to mcrt integrate")
     parser.add_argument("--save-csv", help="also keep the CSV that mcrt wrote here")
@@ -53,17 +51,27 @@ def main():
     args = parser.parse_args()
 
     if args.csv:
-        with open(args.csv) as f:
-            text = f.read()
+        try:
+            with open(args.csv) as f:
+                text = f.read()
+        except OSError as e:
+            raise mcrt_run.ScriptError("cannot read %s: %s" % (args.csv, e.strerror))
     else:
-        cmd = [args.mcrt, "integrate", "--repeats", str(args.repeats), "--seed", str(args.seed)]
+        cmd = [mcrt_run.mcrt_binary(args.mcrt), "integrate", "--repeats", str(args.repeats),
+               "--seed", str(args.seed)]
         print("running:", " ".join(cmd), file=sys.stderr)
-        text = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+        text = mcrt_run.run(cmd).stdout
         if args.save_csv:
             with open(args.save_csv, "w") as f:
                 f.write(text)
-    data = read_rows(text)
+    try:
+        data = read_rows(text)
+    except (KeyError, ValueError) as e:
+        raise mcrt_run.ScriptError("not a CSV of `mcrt integrate`: %s" % e)
+    if not data:
+        raise mcrt_run.ScriptError("no rows in the CSV of `mcrt integrate`")
 
+    plt = mcrt_run.pyplot()
     fig, ax = plt.subplots(figsize=(10, 5.5), dpi=100)
     print(f"fitted log-log slopes over N >= {args.fit_min}:")
     for estimator, rows in data.items():
@@ -95,4 +103,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(mcrt_run.script_main(main))
