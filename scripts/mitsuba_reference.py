@@ -49,6 +49,7 @@ Usage: mitsuba_reference.py SCENE --spp N [--width W --height H] --out X.exr
 
 import argparse
 import base64
+import importlib.util
 import json
 import math
 import os
@@ -59,10 +60,12 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
+import mcrt_run
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from mcrt_exr import read_exr, write_exr  # noqa: E402
+mcrt_run.require("numpy")
+import numpy as np  # noqa: E402
+
+from mcrt_exr import write_exr  # noqa: E402
 
 COMPONENTS = {5120: "<i1", 5121: "<u1", 5122: "<i2", 5123: "<u2", 5125: "<u4", 5126: "<f4"}
 WIDTHS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
@@ -301,14 +304,21 @@ def render(args):
 
 # ----- comparison with an mcrt image ---------------------------------------------------------------
 
+def read_hwc(path):
+    """(rgb, variance or None) of an EXR as (H, W, 3) float64 arrays."""
+    rgb, variance = mcrt_run.read_image_file(path)
+    return (np.moveaxis(rgb, 0, -1),
+            None if variance is None else np.moveaxis(variance, 0, -1))
+
+
 def compare(mitsuba_rgb, mitsuba_var, mcrt_path, png_path):
     """Mean relative difference and its expected size from the two variance layers."""
-    exr = read_exr(mcrt_path)
-    mcrt_rgb = np.stack([exr[c] for c in "RGB"], axis=-1).astype(np.float64)
-    mcrt_var = np.stack([exr["variance." + c] for c in "RGB"], axis=-1).astype(np.float64)
+    mcrt_rgb, mcrt_var = read_hwc(mcrt_path)
+    if mcrt_var is None:
+        raise mcrt_run.ScriptError("%s has no variance layer (an mcrt render has)" % mcrt_path)
     if mcrt_rgb.shape != mitsuba_rgb.shape:
-        sys.exit("mitsuba_reference: %s is %s, the Mitsuba image %s"
-                 % (mcrt_path, mcrt_rgb.shape, mitsuba_rgb.shape))
+        raise mcrt_run.ScriptError("%s is %s, the Mitsuba image %s"
+                                   % (mcrt_path, mcrt_rgb.shape, mitsuba_rgb.shape))
     diff = mcrt_rgb - mitsuba_rgb
     # Combined variance, floored at float rounding (1e-5 relative): where neither image has
     # noise (a light seen directly) the two differ by a float32 rounding of L_e.
@@ -333,9 +343,7 @@ def compare(mitsuba_rgb, mitsuba_var, mcrt_path, png_path):
         "mean_z2": float(np.mean(diff[combined > 0] ** 2 / combined[combined > 0])),
     }
     if png_path:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        plt = mcrt_run.pyplot()
         ref = 0.5 * (mcrt_rgb + mitsuba_rgb)
         scale = 1.0 / max(np.percentile(ref.mean(axis=-1), 99), 1e-6)
 
@@ -359,48 +367,37 @@ def compare(mitsuba_rgb, mitsuba_var, mcrt_path, png_path):
             100 * result["relative_difference_of_means"],
             100 * result["relative_difference_of_means_stderr"], result["mean_z2"]), fontsize=8)
         fig.tight_layout()
-        import experiment
-        experiment.save_png(fig, png_path)
+        mcrt_run.save_png(fig, png_path)
         plt.close(fig)
     return result
 
 
 def equal_time(args, mitsuba_rgb):
     """mcrt (each --mcrt-args) for the seconds Mitsuba took; the RMSEs against the reference."""
-    import subprocess
     info = json.loads(Path(str(args.out) + ".json").read_text())
     seconds = info["seconds_render"]
-    exr = read_exr(args.equal_time)
-    ref = np.stack([exr[c] for c in "RGB"], axis=-1).astype(np.float64)
-    floor = (math.sqrt(float(np.mean([exr["variance." + c] for c in "RGB"])))
-             if "variance.R" in exr else 0.0)
+    ref, ref_variance = read_hwc(args.equal_time)
+    floor = math.sqrt(float(np.mean(ref_variance))) if ref_variance is not None else 0.0
     rmse = lambda x: math.sqrt(float(np.mean((x - ref) ** 2)))  # noqa: E731
     result = {"reference": str(args.equal_time), "reference_rmse_floor_layer": floor,
               "mitsuba": {"variant": args.variant, "spp": info["spp"], "seconds": seconds,
                           "rmse": rmse(mitsuba_rgb)}, "mcrt": []}
     for options in args.mcrt_args or ["--estimator mis --sampler sobol --light-select power"]:
         with tempfile.TemporaryDirectory(prefix="mcrt-equal-time-") as scratch:
-            out, stats_path = Path(scratch) / "m.exr", Path(scratch) / "m.json"
-            command = [args.mcrt, "render", str(args.scene), "--out", str(out), "--stats",
-                       str(stats_path), "--width", str(args.width), "--height", str(args.height),
-                       "--spp", "16777216", "--time-limit", repr(seconds), "--seed",
-                       str(args.seed + 17), "--quiet"] + shlex.split(options)
-            start = time.monotonic()
-            subprocess.run(command, check=True)
-            wall = time.monotonic() - start
-            stats = json.loads(stats_path.read_text())
-            m = read_exr(out)
-            mcrt_rgb = np.stack([m[c] for c in "RGB"], axis=-1).astype(np.float64)
-        result["mcrt"].append({"options": options, "spp": stats["spp"],
-                               "seconds_render": stats["seconds_render"],
-                               "seconds_total": stats["seconds_total"], "wall_seconds": wall,
-                               "rmse": rmse(mcrt_rgb)})
+            r = mcrt_run.render(args.scene, Path(scratch) / "m", [
+                "--width", args.width, "--height", args.height, "--spp", "16777216",
+                "--time-limit", repr(seconds), "--seed", args.seed + 17] + shlex.split(options),
+                mcrt=args.mcrt)
+        result["mcrt"].append({"options": options, "spp": r.stats["spp"],
+                               "seconds_render": r.stats["seconds_render"],
+                               "seconds_total": r.stats["seconds_total"],
+                               "wall_seconds": r.wall_seconds,
+                               "rmse": rmse(np.moveaxis(r.rgb, 0, -1))})
     return result
 
 
 def use_mitsuba_venv():
     """Re-executes this script with a repository venv's Python when mitsuba is not importable."""
-    import importlib.util
     if importlib.util.find_spec("mitsuba") is not None:
         return
     root = Path(__file__).resolve().parent.parent
@@ -408,7 +405,7 @@ def use_mitsuba_venv():
         python = root / venv / "bin" / "python"
         if python.exists() and Path(sys.prefix).resolve() != (root / venv).resolve():
             os.execv(str(python), [str(python), str(Path(__file__).resolve())] + sys.argv[1:])
-    sys.exit("mitsuba_reference: error: Mitsuba 3 is not installed (see --help)")
+    raise mcrt_run.ScriptError("Mitsuba 3 is not installed (see --help)")
 
 
 def main():
@@ -428,13 +425,20 @@ def main():
     p.add_argument("--diff-png", help="with --compare: write the difference image here")
     p.add_argument("--equal-time", metavar="REF.exr",
                    help="also render with mcrt for Mitsuba's time and compare both with REF.exr")
-    p.add_argument("--mcrt", default=str(Path(__file__).resolve().parent.parent / "build" / "mcrt"))
+    mcrt_run.add_mcrt_option(p)
     p.add_argument("--mcrt-args", action="append",
                    help="mcrt render options for --equal-time, repeatable (default: --estimator "
                    "mis --sampler sobol --light-select power)")
     args = p.parse_args()
     use_mitsuba_venv()
-    rgb, variance = render(args)
+    if args.diff_png and importlib.util.find_spec("matplotlib") is None:
+        # checked before the render, not re-executed after it: this Python is Mitsuba's
+        raise mcrt_run.ScriptError("--diff-png needs matplotlib in %s (a venv made with "
+                                   "--system-site-packages has Debian's)" % sys.executable)
+    try:
+        rgb, variance = render(args)
+    except (OSError, ValueError) as e:  # an unreadable scene, an unsupported accessor
+        raise mcrt_run.ScriptError("%s: %s" % (args.scene, e))
     if args.compare:
         result = compare(rgb, variance, args.compare, args.diff_png)
         print(json.dumps(result, indent=1))
@@ -443,4 +447,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(mcrt_run.script_main(main))
