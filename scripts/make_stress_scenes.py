@@ -19,7 +19,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from make_test_gltf import FLOAT, Gltf, primitive  # noqa: E402  (the same glTF writer)
+from make_test_gltf import FLOAT, Gltf, primitive, write_files  # noqa: E402  (the same glTF writer)
 
 
 def sub(a, b):
@@ -272,12 +272,8 @@ SCENES = {
 
 
 def main():
-    default = Path(__file__).resolve().parent.parent / "scenes" / "stress"
-    out = Path(sys.argv[1]) if len(sys.argv) > 1 else default
-    out.mkdir(parents=True, exist_ok=True)
-    for name, make in SCENES.items():
-        path = out / (name + ".gltf")
-        make().write(path)
+    _, paths = write_files(SCENES, Path(__file__).resolve().parent.parent / "scenes" / "stress")
+    for path in paths:
         print("%s: %d bytes" % (path, path.stat().st_size))
 
 

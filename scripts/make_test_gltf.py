@@ -323,12 +323,20 @@ FILES = {
 }
 
 
-def main():
-    default = Path(__file__).resolve().parent.parent / "tests" / "data"
-    out = Path(sys.argv[1]) if len(sys.argv) > 1 else default
+def write_files(files, default_dir):
+    """Writes OUT/NAME.gltf of every NAME → make() of `files`, OUT the first command-line
+    argument or `default_dir` (both generators' main); returns OUT and the paths."""
+    out = Path(sys.argv[1]) if len(sys.argv) > 1 else default_dir
     out.mkdir(parents=True, exist_ok=True)
-    for name, make in FILES.items():
-        make().write(out / (name + ".gltf"))
+    paths = []
+    for name, make in files.items():
+        paths.append(out / (name + ".gltf"))
+        make().write(paths[-1])
+    return out, paths
+
+
+def main():
+    out, _ = write_files(FILES, Path(__file__).resolve().parent.parent / "tests" / "data")
     print("wrote %d files to %s" % (len(FILES), out))
 
 
