@@ -8,6 +8,11 @@
     r = mcrt_run.render(scene, stem, ["--estimator", "mis", "--spp", "64"])
     r.rgb, r.variance, r.stats, r.wall_seconds
 
+Also: estimator_arguments / estimator_label / uses_light_select / check_estimators for built-in
+names and users' FILE.cl alike; read_image_file (an EXR as (3, H, W) arrays); comma_list,
+image_size, add_mcrt_option, check_choices for command lines; pyplot and save_png for charts.
+Scripts that only read the stats JSON (render(..., read_image=False)) need no numpy.
+
 Errors are raised as ScriptError (one line, naming the command); `script_main` turns them into
 one `NAME: error: ...` line and exit status 2, so no script prints a traceback for them.
 """
@@ -44,10 +49,11 @@ def require(*modules):
             and not os.environ.get("MCRT_SCRIPT_REEXEC")):
         os.environ["MCRT_SCRIPT_REEXEC"] = "1"
         os.execv(SYSTEM_PYTHON, [SYSTEM_PYTHON, script] + sys.argv[1:])
-    raise SystemExit("%s: error: this Python (%s) lacks %s; run it with %s and Debian's "
-                     "python3-numpy / python3-matplotlib (scripts/setup installs them)"
-                     % (os.path.basename(script), sys.executable, ", ".join(missing),
-                        SYSTEM_PYTHON))
+    print("%s: error: this Python (%s) lacks %s; run it with %s and Debian's "
+          "python3-numpy / python3-matplotlib (scripts/setup installs them)"
+          % (os.path.basename(script), sys.executable, ", ".join(missing), SYSTEM_PYTHON),
+          file=sys.stderr)
+    raise SystemExit(2)  # as script_main's one line
 
 
 def script_main(main):
