@@ -140,18 +140,9 @@ def estimator_uses(estimator, mcrt=None):
 
 
 def uses_light_select(estimator, mcrt=None):
-    """True when --light-select changes what `estimator` computes: it samples a light (so not
-    the hemisphere estimators, which count the emitters their directions hit, though they
-    "use" lights). The table has no bit for it yet: a "light-select" use when it has one, else
-    a built-in whose description names --light-select or that weighs with --mis-heuristic
-    (MIS samples a light); a user's file may call the light sampling API, so True."""
-    if is_estimator_file(estimator):
-        return True
-    uses = estimator_uses(estimator, mcrt)
-    if "light-select" in uses:
-        return True
-    row = next(r for r in variants(mcrt)["estimators"] if r["name"] == estimator)
-    return "--light-select" in row.get("description", "") or "mis-heuristic" in uses
+    """True when --light-select changes what `estimator` computes: its uses include
+    "light-selection" (a user's file is assumed to, as the table's user_estimator row says)."""
+    return "light-selection" in estimator_uses(estimator, mcrt)
 
 
 def check_estimators(estimators, mcrt=None):

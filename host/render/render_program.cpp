@@ -1,5 +1,6 @@
 #include "render/render_program.h"
 
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -38,18 +39,23 @@ KernelReplacements render_program_replacements(const RenderSettings& settings) {
 
 namespace {
 
-// The first line of the build log that reports an error in `file`, as "FILE:LINE: message"
-// (clang's "FILE:LINE:COLUMN: error: message"); "" when the log names none.
+// The first error the build log reports in `file`, as "FILE:LINE: message", from clang's
+// "FILE:LINE:COLUMN: error: message" (PoCL prefixes "error: "); "" when the log names none.
 std::string first_error_in(const std::string& log, const std::string& file) {
     std::istringstream in(log);
     std::string line;
+    const std::string prefix = file + ":";
     while (std::getline(in, line)) {
-        if (line.compare(0, file.size() + 1, file + ":") != 0) continue;
-        size_t error = line.find("error:");
-        if (error == std::string::npos) continue;
-        size_t line_end = line.find(':', file.size() + 1);
-        std::string line_number = line.substr(file.size() + 1, line_end - file.size() - 1);
-        return file + ":" + line_number + ": " + line.substr(error);
+        size_t at = line.find(prefix);
+        if (at == std::string::npos || line.find("error") == std::string::npos) continue;
+        size_t digits = at + prefix.size(), end = digits;
+        while (end < line.size() && std::isdigit(static_cast<unsigned char>(line[end]))) ++end;
+        if (end == digits) continue;
+        // The message after "LINE:COLUMN: ".
+        size_t message = line.find(": ", end);
+        std::string text = message == std::string::npos ? line : line.substr(message + 2);
+        if (text.rfind("error: ", 0) == 0) text = text.substr(7);
+        return prefix + line.substr(digits, end - digits) + ": " + text;
     }
     return "";
 }

@@ -34,6 +34,7 @@ struct OptionVariant {
     const char* description;
 };
 
+// Globals of variants.cpp: read them at run time, not from other files' static initializers.
 extern const std::vector<EstimatorVariant> kEstimatorVariants;
 extern const std::vector<OptionVariant> kLightSelectVariants;
 extern const std::vector<OptionVariant> kSamplerVariants;

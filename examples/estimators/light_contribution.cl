@@ -1,0 +1,85 @@
+/* The course's last question, as a user's estimator: choose the light in proportion to its
+ * estimated contribution at the shading point, not to its power.
+ *
+ *     mcrt render scenes/stress/light-facing-away.gltf --out a.exr \
+ *         --estimator-file examples/estimators/light_contribution.cl
+ *
+ * Each light i gets the importance
+ *
+ *     w_i = lum(Le_i) · area_i · max(cosθ_x, c) · max(cosθ_y, c) / max(d², area_i)
+ *
+ * at its centroid (c = 0.05 keeps the estimate of a poorly seen light from collapsing), and
+ * w_i = 0 exactly when the light cannot contribute at all: its emitting side faces away from
+ * the shading point, or all three corners lie below the shading point's horizon (n · (y − x) is
+ * linear in y, so then every point of the triangle does). Every light that can contribute has
+ * w_i > 0, so the estimator is unbiased whatever the weights' quality. The light is chosen by
+ * walking the weights with u · Σw (two passes over the lights: O(lights) per sample, for scenes
+ * of tens to hundreds of lights — a light tree does it in O(log lights)); pmf = w_i / Σw; the
+ * point is uniform on the light, as in light-area. The random numbers are light-area's
+ * (DIM_LIGHT_SELECT, DIM_LIGHT_POINT): the two compare on common random numbers. */
+
+#define CONTRIBUTION_COSINE_FLOOR 0.05f
+
+inline float luminance(float3 c) { return dot(c, (float3)(0.2126f, 0.7152f, 0.0722f)); }
+
+/* The importance w_i of light i at the shading point (0: it cannot contribute there). */
+inline float light_importance(const SurfacePoint* sp, const Light* light) {
+    float3 p0 = light->p0.xyz, p1 = light->p1.xyz, p2 = light->p2.xyz;
+    float3 n_light = light_normal(light);
+    float facing = dot(n_light, sp->p - p0); /* > 0: sp is on the front side */
+    if (!light_double_sided(light) && facing <= 0.0f) return 0.0f;
+    float above = fmax(dot(sp->n, p0 - sp->p), fmax(dot(sp->n, p1 - sp->p), dot(sp->n, p2 - sp->p)));
+    if (!(above > 0.0f)) return 0.0f;
+
+    float3 to_centroid = (p0 + p1 + p2) * (1.0f / 3.0f) - sp->p;
+    float d2 = dot(to_centroid, to_centroid);
+    float area = light_area(light);
+    float inv_d = d2 > 0.0f ? rsqrt(d2) : 0.0f;
+    float cos_x = fmax(dot(sp->n, to_centroid) * inv_d, CONTRIBUTION_COSINE_FLOOR);
+    float cos_y = fmax(fabs(facing) * inv_d, CONTRIBUTION_COSINE_FLOOR);
+    return luminance(light->Le.xyz) * area * cos_x * cos_y / fmax(d2, area);
+}
+
+float3 estimate(const SceneView* scene, const SurfacePoint* sp, const SampleStream* stream,
+                uint* rays) {
+    uint n = scene->lights.light_count;
+    if (n == 0u) return (float3)(0.0f);
+
+    /* Light selection by estimated contribution: the total, then the walk. */
+    float total = 0.0f;
+    for (uint i = 0u; i < n; ++i) {
+        Light light = scene->lights.lights[i];
+        total += light_importance(sp, &light);
+    }
+    if (!(total > 0.0f)) return (float3)(0.0f); /* no light can reach this point */
+    float target = sample_1d(stream, DIM_LIGHT_SELECT) * total;
+    uint chosen = n;
+    float w_chosen = 0.0f, running = 0.0f;
+    for (uint i = 0u; i < n; ++i) {
+        Light light = scene->lights.lights[i];
+        float w = light_importance(sp, &light);
+        if (w <= 0.0f) continue;
+        chosen = i; /* the last light with weight, should rounding leave target beyond the sum */
+        w_chosen = w;
+        running += w;
+        if (target < running) break;
+    }
+    float pmf = w_chosen / total;
+
+    /* A uniform point on the chosen light (density 1/area), as light-area. */
+    Light light = scene->lights.lights[chosen];
+    LightPoint lp = sample_light_point(&light, sample_2d(stream, DIM_LIGHT_POINT));
+    float3 to_light = lp.p - sp->p;
+    float d2 = dot(to_light, to_light);
+    if (!(d2 > 0.0f)) return (float3)(0.0f);
+    float3 wi = to_light * rsqrt(d2);
+    float3 n_light = light_normal(&light);
+    float cos_x = dot(sp->n, wi);
+    float cos_y = light_emitting_cosine(&light, n_light, wi);
+    if (cos_x <= 0.0f || cos_y <= 0.0f) return (float3)(0.0f);
+
+    *rays += 1u;
+    float3 n_toward_x = dot(n_light, wi) < 0.0f ? n_light : -n_light;
+    if (!visible(scene, sp->p, sp->n, lp.p, n_toward_x)) return (float3)(0.0f);
+    return bsdf_eval(sp, wi) * light.Le.xyz * (cos_x * cos_y / (d2 * lp.pdf_a * pmf));
+}
