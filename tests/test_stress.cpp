@@ -20,6 +20,7 @@
 #include "analytic_scenes.h"
 #include "bvh/bvh.h"
 #include "device_support.h"
+#include "example_estimators.h"
 #include "independent_renders.h"
 #include "image/image.h"
 #include "process_support.h"
@@ -270,6 +271,36 @@ TEST_CASE(
                       << standard_error.at(f.better));
             CHECK(standard_error.at(f.worse) > f.factor * standard_error.at(f.better));
         }
+    }
+}
+
+TEST_CASE("stress scenes: every example estimator file is finite and unbiased",
+          "[stress][estimators][analytic][estimator-file]") {
+    DeviceContext device = first_device();
+    RenderSettings settings;
+    settings.width = 16;
+    settings.height = 16;
+    settings.spp = 32;
+    const std::vector<std::string> files = example_estimator_files();
+    REQUIRE(files.size() >= 2);
+    for (const std::string& name : kStressScenes) {
+        Scene scene = load_stress_scene(name);
+        GpuSceneData data =
+            make_gpu_scene(scene, build_bvh(scene), scene.cameras.front(), settings.width, settings.height);
+        glm::dvec3 exact = image_mean(exact_image(scene, scene.cameras.front(), 16, 16));
+        for (const std::string& file : files)
+            for (const std::string& select : variant_names(kLightSelectVariants)) {
+                use_estimator_file(settings, file);
+                settings.light_select = select;
+                Renders r = independent_renders(device, data, settings, kRenders, kFirstSeed);
+                INFO(name << ": " << file << " / " << select << ": mean " << format(r.mean)
+                          << ", exact " << format(exact) << ", standard error "
+                          << format(r.standard_error));
+                CHECK(r.nan_samples == 0);
+                CHECK(r.non_finite_pixels == 0);
+                for (int c = 0; c < 3; ++c)
+                    CHECK(std::abs(r.mean[c] - exact[c]) <= 4.5 * r.standard_error[c]);
+            }
     }
 }
 

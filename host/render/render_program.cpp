@@ -3,6 +3,7 @@
 #include <cctype>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include "common/error.h"
@@ -87,6 +88,13 @@ std::string read_estimator_file(const std::string& path) {
     std::ostringstream text;
     text << in.rdbuf();
     if (!in) throw InputError("--estimator-file " + path + ": cannot read");
+    // The kernel calls the user's function by name: say so before a compiler would, in mcrt's
+    // own source, that it is missing.
+    static const std::regex definition(std::string("\\b") + kUserEstimatorFunction + "\\s*\\(");
+    if (!std::regex_search(text.str(), definition))
+        throw InputError("--estimator-file " + path + ": defines no function float3 " +
+                         kUserEstimatorFunction + "(const SceneView*, const SurfacePoint*, "
+                         "const SampleStream*, uint*) (docs/ESTIMATORS.md)");
     return text.str();
 }
 

@@ -24,7 +24,8 @@ KernelReplacements render_program_replacements(const RenderSettings& settings);
 // followed by the build log; any other build failure throws RuntimeError with the log.
 cl::Program render_program(const DeviceContext& device, const RenderSettings& settings);
 
-// The text of a user's estimator file; throws InputError when it is not a readable regular file.
+// The text of a user's estimator file; throws InputError when it is not a readable regular file
+// or defines no `estimate` function.
 std::string read_estimator_file(const std::string& path);
 
 }  // namespace mcrt

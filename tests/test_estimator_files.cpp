@@ -1,0 +1,147 @@
+// Users' estimators (--estimator-file, docs/ESTIMATORS.md): the example re-implementing
+// light-area through the public API renders the built-in's image bit for bit; build errors name
+// the user's FILE:LINE with exit 2 and write nothing; every example in examples/estimators is
+// unbiased on the analytic plane scene (error bars from independent renders, as the built-ins).
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+
+#include "analytic_scenes.h"
+#include "device_support.h"
+#include "example_estimators.h"
+#include "image/image.h"
+#include "independent_renders.h"
+#include "process_support.h"
+#include "render/variants.h"
+
+using namespace mcrt;
+using namespace mcrt::test;
+
+namespace {
+
+const std::string kCornell = std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf";
+const std::string kLightArea = std::string(MCRT_EXAMPLES) + "/estimators/light_area.cl";
+
+bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
+
+ProcessResult run_mcrt(const TempDir& tmp, const std::vector<std::string>& args) {
+    ProcessResult r = run_process(MCRT_EXE, args, tmp.path(), 120.0);
+    INFO("mcrt " << args.front() << "...: exit " << r.exit_code << "\n  stderr: " << r.err);
+    CHECK_FALSE(r.timed_out);
+    return r;
+}
+
+}  // namespace
+
+TEST_CASE("examples/estimators/light_area.cl renders light-area's image bit for bit",
+          "[estimator-file][cli]") {
+    TempDir tmp("mcrt-estimator-file");
+    for (const char* sampler : {"independent", "sobol", "stratified"})
+        for (const char* select : {"power", "uniform"}) {
+            std::vector<std::string> common = {kCornell, "--width", "40", "--height", "32",
+                                               "--spp", "48", "--seed", "11", "--sampler",
+                                               sampler, "--light-select", select, "--quiet"};
+            std::vector<std::string> builtin = {"render", "--out", tmp / "builtin.exr",
+                                                "--estimator", "light-area"};
+            std::vector<std::string> file = {"render", "--out", tmp / "file.exr",
+                                             "--estimator-file", kLightArea};
+            builtin.insert(builtin.end(), common.begin(), common.end());
+            file.insert(file.end(), common.begin(), common.end());
+            INFO(sampler << " / " << select);
+            REQUIRE(run_mcrt(tmp, builtin).exit_code == 0);
+            REQUIRE(run_mcrt(tmp, file).exit_code == 0);
+            Image a = read_exr(tmp / "builtin.exr"), b = read_exr(tmp / "file.exr");
+            double sum = 0;
+            for (float v : a.rgb) sum += v;
+            CHECK(sum > 0);  // not two black images
+            CHECK(same_bits(a.rgb, b.rgb));
+            CHECK(same_bits(a.variance, b.variance));
+        }
+}
+
+TEST_CASE("a build error in an estimator file names FILE:LINE, exits 2 and writes nothing",
+          "[estimator-file][cli]") {
+    TempDir tmp("mcrt-estimator-file");
+    const std::string file = tmp / "broken.cl";
+    std::ofstream(file) << "/* a user's estimator with an error on line 3 */\n"
+                           "float3 estimate(const SceneView* scene, const SurfacePoint* sp, "
+                           "const SampleStream* stream, uint* rays) {\n"
+                           "    return not_declared_anywhere * sp->n;\n"
+                           "}\n";
+    const std::string out = tmp / "x.exr";
+    ProcessResult r = run_mcrt(tmp, {"render", kCornell, "--out", out, "--png", tmp / "x.png",
+                                 "--stats", tmp / "x.json", "--estimator-file", file, "--width",
+                                 "8", "--height", "8", "--quiet"});
+    CHECK(r.exit_code == 2);
+    // One error line, naming the file and line; the build log follows it.
+    size_t first = r.err.find("mcrt: error: ");
+    REQUIRE(first != std::string::npos);
+    CHECK(r.err.find("mcrt: error: ", first + 1) == std::string::npos);
+    std::string line = r.err.substr(first, r.err.find('\n', first) - first);
+    INFO(line);
+    CHECK(line.find(file + ":3") != std::string::npos);
+    CHECK(line.find("not_declared_anywhere") != std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(out));
+    CHECK_FALSE(std::filesystem::exists(tmp / "x.png"));
+    CHECK_FALSE(std::filesystem::exists(tmp / "x.json"));
+}
+
+TEST_CASE("estimator files that cannot be used are refused with exit 2", "[estimator-file][cli]") {
+    TempDir tmp("mcrt-estimator-file");
+    std::vector<std::string> base = {"render", kCornell, "--out", tmp / "x.exr", "--quiet"};
+    auto with = [&](std::vector<std::string> extra) {
+        std::vector<std::string> a = base;
+        a.insert(a.end(), extra.begin(), extra.end());
+        return a;
+    };
+    ProcessResult missing = run_mcrt(tmp, with({"--estimator-file", tmp / "nope.cl"}));
+    CHECK(missing.exit_code == 2);
+    CHECK(missing.err.find("nope.cl") != std::string::npos);
+    ProcessResult directory = run_mcrt(tmp, with({"--estimator-file", tmp.path().string()}));
+    CHECK(directory.exit_code == 2);
+    CHECK(directory.err.find("not a regular file") != std::string::npos);
+    ProcessResult both = run_mcrt(tmp, with({"--estimator-file", kLightArea, "--estimator", "mis"}));
+    CHECK(both.exit_code == 2);
+    // A file that defines no `estimate` is refused before any build, naming the function.
+    std::ofstream(tmp / "empty.cl") << "/* nothing */\n";
+    ProcessResult empty = run_mcrt(tmp, with({"--estimator-file", tmp / "empty.cl"}));
+    CHECK(empty.exit_code == 2);
+    CHECK(empty.err.find("defines no function float3 estimate") != std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(tmp / "x.exr"));
+}
+
+TEST_CASE("every example estimator is unbiased on a polygon light over a plane",
+          "[estimator-file][estimators][analytic]") {
+    DeviceContext device = first_device();
+    PlaneScene ps;
+    RenderSettings settings;
+    settings.width = 16;
+    settings.height = 16;
+    settings.spp = 64;
+    GpuSceneData data = gpu_scene_for(ps.scene, ps.camera, settings);
+    glm::dvec3 exact = image_mean(ps.exact_image(settings.width, settings.height));
+    const std::vector<std::string> files = example_estimator_files();
+    REQUIRE(files.size() >= 2);
+    for (const std::string& file : files)
+        for (const std::string& select : variant_names(kLightSelectVariants))
+            for (const std::string& sampler : variant_names(kSamplerVariants)) {
+                use_estimator_file(settings, file);
+                settings.light_select = select;
+                settings.sampler = sampler;
+                Renders r = independent_renders(device, data, settings, 10, 1000);
+                INFO(file << " / " << select << " / " << sampler << ": mean (" << r.mean.x << ", "
+                          << r.mean.y << ", " << r.mean.z << "), exact (" << exact.x << ", "
+                          << exact.y << ", " << exact.z << "), standard error ("
+                          << r.standard_error.x << ", " << r.standard_error.y << ", "
+                          << r.standard_error.z << ")");
+                CHECK(r.nan_samples == 0);
+                CHECK(r.non_finite_pixels == 0);
+                for (int c = 0; c < 3; ++c)
+                    CHECK(std::abs(r.mean[c] - exact[c]) <= 4.5 * r.standard_error[c]);
+                CHECK(r.standard_error.x < 0.05 * exact.x);  // not vacuous
+            }
+}
