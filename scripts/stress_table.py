@@ -46,14 +46,16 @@ SCENES = ["tiny-bright-light", "near-light", "grazing-light", "light-facing-away
 SELECTION_SCENES = {"light-facing-away", "many-lights"}
 
 
-def estimators(mcrt):
+def estimators(mcrt, chosen=None):
     """(label, estimator, extra arguments, samples a light) of each direct-light estimator of
-    the table of variants (DESIGN.md): those that sample a light first, an MIS one once per
-    heuristic, labelled "mis (balance)"."""
+    the table of variants (DESIGN.md), or of `chosen` (names or users' .cl files): those that
+    sample a light first, an MIS one once per heuristic, labelled "mis (balance)"."""
     rows = []
-    for name in mcrt_run.names("estimators", uses="lights", mcrt=mcrt):
+    for name in chosen or mcrt_run.names("estimators", uses="lights", mcrt=mcrt):
         samples_light = mcrt_run.uses_light_select(name, mcrt)
-        if "mis-heuristic" in mcrt_run.estimator_uses(name, mcrt):
+        if mcrt_run.is_estimator_file(name):  # the user's file says which heuristic, if any
+            rows.append((mcrt_run.estimator_label(name), name, [], samples_light))
+        elif "mis-heuristic" in mcrt_run.estimator_uses(name, mcrt):
             rows += [("%s (%s)" % (name, h), name, ["--mis-heuristic", h], samples_light)
                      for h in mcrt_run.names("mis_heuristics", mcrt=mcrt)]
         else:
@@ -64,11 +66,12 @@ def estimators(mcrt):
 # ----- measurements ----------------------------------------------------------------------------
 
 def render(mcrt, scene, estimator, extra, select, seed, args, scratch):
-    stem = scratch / ("%s-%s%s-%s-%d" % (scene, estimator, "".join(extra[1:]), select, seed))
+    stem = scratch / ("%s-%s%s-%s-%d" % (scene, mcrt_run.estimator_label(estimator),
+                                         "".join(extra[1:]), select, seed))
     r = mcrt_run.render(ROOT / "scenes" / "stress" / (scene + ".gltf"), stem,
                         ["--width", args.size, "--height", args.size, "--spp", args.spp,
-                         "--estimator", estimator, "--light-select", select, "--seed", seed]
-                        + extra, mcrt=mcrt)
+                         "--light-select", select, "--seed", seed]
+                        + mcrt_run.estimator_arguments(estimator) + extra, mcrt=mcrt)
     return r.rgb, r.variance, r.stats
 
 
@@ -102,8 +105,13 @@ def main():
     parser.add_argument("--size", type=int, default=128, help="image width and height")
     parser.add_argument("--scenes", nargs="+", default=SCENES, choices=SCENES)
     parser.add_argument("--keep", help="keep the EXRs and JSONs in this directory")
+    parser.add_argument("--estimators", type=mcrt_run.comma_list,
+                        help="comma-separated names or users' .cl files (default: every direct "
+                             "estimator of `mcrt variants`)")
     args = parser.parse_args()
-    table = estimators(args.mcrt)
+    if args.estimators:
+        mcrt_run.check_estimators(args.estimators, args.mcrt)
+    table = estimators(args.mcrt, args.estimators)
     selections = mcrt_run.names("light_select", mcrt=args.mcrt)
     order = ["power"] + [s for s in selections if s != "power"]  # the default first
 
