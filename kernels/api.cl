@@ -6,13 +6,13 @@
 #ifndef MCRT_API_CL
 #define MCRT_API_CL
 
-#include "shared_types.h"
-#include "rng.cl"
+#include "bsdf.cl"
 #include "frame.cl"
+#include "light_sampling.cl"
+#include "rng.cl"
 #include "sampling.cl"
 #include "scene.cl"
-#include "bsdf.cl"
-#include "light_sampling.cl"
+#include "shared_types.h"
 
 /* Weight of strategy a against b, both densities in solid angle (Veach 1997, sec. 9.2): balance,
  * or power with β = 2 (-D MIS_POWER, `--mis-heuristic power`), written as ratios so large

@@ -56,8 +56,8 @@ inline float light_area_pdf_w(float pmf, float pdf_a, float d2, float cos_light)
 
 /* ---- Area strategy: (light, point) with density pmf(light)/area ------------------------------ */
 
-inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint* sp,
-                                     float u_select, float2 u_point) {
+inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint* sp, float u_select,
+                                     float2 u_point) {
     LightSample ls = no_light_sample();
     if (scene->lights.light_count == 0u) return ls;
     DiscreteSample choice = select_light(&scene->lights, u_select);
@@ -140,7 +140,8 @@ inline LightSample sample_light_solid_angle(const SceneView* scene, const Surfac
     return ls;
 }
 
-/* ---- Using a light sample ---------------------------------------------------------------------- */
+/* ---- Using a light sample ----------------------------------------------------------------------
+ */
 
 /* cosθ_x · G / density, in the sample's own measure: cosθ_x cosθ_y / (d² pdf_a pmf) per area,
  * cosθ_x / (pdf_w pmf) per solid angle, so that f · Le · weight is the estimate. */
@@ -194,8 +195,7 @@ inline float pdf_light_solid_angle(const SceneView* scene, const SurfacePoint* s
            c = normalize(light.p2.xyz - x);
     float omega = spherical_triangle_solid_angle(a, b, c);
     float pmf = light_pmf(&scene->lights, index);
-    if (omega > MIN_SPHERICAL_SOLID_ANGLE && omega < MAX_SPHERICAL_SOLID_ANGLE)
-        return pmf / omega;
+    if (omega > MIN_SPHERICAL_SOLID_ANGLE && omega < MAX_SPHERICAL_SOLID_ANGLE) return pmf / omega;
     float3 d = seen->p - x;
     return pmf * pdf_area_to_solid_angle(sample_triangle_uniform_pdf_a(light_area(&light)),
                                          dot(d, d), cos_y);

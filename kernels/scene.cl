@@ -22,11 +22,11 @@ typedef struct {
 
 /* A surface point seen along a ray. */
 typedef struct {
-    float3 p;      /* from barycentrics, not from o + t·d (Wächter & Binder 2019) */
-    float3 n;      /* unit geometric normal, flipped toward the incoming ray */
-    float3 wo;     /* unit, toward where the ray came from */
-    bool front;    /* the ray arrived on the counter-clockwise (front) side */
-    uint light;    /* index of its Light plus one; 0 when it is not a light */
+    float3 p;   /* from barycentrics, not from o + t·d (Wächter & Binder 2019) */
+    float3 n;   /* unit geometric normal, flipped toward the incoming ray */
+    float3 wo;  /* unit, toward where the ray came from */
+    bool front; /* the ray arrived on the counter-clockwise (front) side */
+    uint light; /* index of its Light plus one; 0 when it is not a light */
     Material material;
 } SurfacePoint;
 

@@ -3,7 +3,6 @@
 // the user's FILE:LINE with exit 2 and write nothing; every example in examples/estimators is
 // unbiased on the analytic plane scene (error bars from independent renders, as the built-ins).
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -42,9 +41,9 @@ TEST_CASE("examples/estimators/light_area.cl renders light-area's image bit for 
     TempDir tmp("mcrt-estimator-file");
     for (const char* sampler : {"independent", "sobol", "stratified"})
         for (const char* select : {"power", "uniform"}) {
-            std::vector<std::string> common = {kCornell, "--width", "40", "--height", "32",
-                                               "--spp", "48", "--seed", "11", "--sampler",
-                                               sampler, "--light-select", select, "--quiet"};
+            std::vector<std::string> common = {
+                kCornell, "--width",   "40",    "--height",       "32",   "--spp",  "48", "--seed",
+                "11",     "--sampler", sampler, "--light-select", select, "--quiet"};
             std::vector<std::string> builtin = {"render", "--out", tmp / "builtin.exr",
                                                 "--estimator", "light-area"};
             std::vector<std::string> file = {"render", "--out", tmp / "file.exr",
@@ -73,9 +72,9 @@ TEST_CASE("a build error in an estimator file names FILE:LINE, exits 2 and write
                            "    return not_declared_anywhere * sp->n;\n"
                            "}\n";
     const std::string out = tmp / "x.exr";
-    ProcessResult r = run_mcrt(tmp, {"render", kCornell, "--out", out, "--png", tmp / "x.png",
-                                 "--stats", tmp / "x.json", "--estimator-file", file, "--width",
-                                 "8", "--height", "8", "--quiet"});
+    ProcessResult r = run_mcrt(
+        tmp, {"render", kCornell, "--out", out, "--png", tmp / "x.png", "--stats", tmp / "x.json",
+              "--estimator-file", file, "--width", "8", "--height", "8", "--quiet"});
     CHECK(r.exit_code == 2);
     // One error line, naming the file and line; the build log follows it.
     size_t first = r.err.find("mcrt: error: ");
@@ -104,7 +103,8 @@ TEST_CASE("estimator files that cannot be used are refused with exit 2", "[estim
     ProcessResult directory = run_mcrt(tmp, with({"--estimator-file", tmp.path().string()}));
     CHECK(directory.exit_code == 2);
     CHECK(directory.err.find("not a regular file") != std::string::npos);
-    ProcessResult both = run_mcrt(tmp, with({"--estimator-file", kLightArea, "--estimator", "mis"}));
+    ProcessResult both =
+        run_mcrt(tmp, with({"--estimator-file", kLightArea, "--estimator", "mis"}));
     CHECK(both.exit_code == 2);
     // A file that defines no `estimate` is refused before any build, naming the function.
     std::ofstream(tmp / "empty.cl") << "/* nothing */\n";

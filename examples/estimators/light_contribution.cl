@@ -28,7 +28,8 @@ inline float light_importance(const SurfacePoint* sp, const Light* light) {
     float3 n_light = light_normal(light);
     float facing = dot(n_light, sp->p - p0); /* > 0: sp is on the front side */
     if (!light_double_sided(light) && facing <= 0.0f) return 0.0f;
-    float above = fmax(dot(sp->n, p0 - sp->p), fmax(dot(sp->n, p1 - sp->p), dot(sp->n, p2 - sp->p)));
+    float above =
+        fmax(dot(sp->n, p0 - sp->p), fmax(dot(sp->n, p1 - sp->p), dot(sp->n, p2 - sp->p)));
     if (!(above > 0.0f)) return 0.0f;
 
     float3 to_centroid = (p0 + p1 + p2) * (1.0f / 3.0f) - sp->p;

@@ -1,9 +1,8 @@
 #include "cli/cli.h"
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iostream>
-
-#include <CLI/CLI.hpp>
 
 #include "bench/bench.h"
 #include "cl/device.h"
@@ -36,18 +35,27 @@ CLI::App* add_bench_command(CLI::App& app, BenchOptions& o) {
     cmd->add_option("scene", o.scene, "glTF scene (.gltf or .glb)")->required();
     cmd->add_option("--rays", o.rays, "ray kind (default: all three)")
         ->check(CLI::IsMember({"primary", "shadow", "ambient"}));
-    cmd->add_option("--width", o.width, "image width")->capture_default_str()->check(CLI::Range(1, 16384));
-    cmd->add_option("--height", o.height, "image height")->capture_default_str()->check(CLI::Range(1, 16384));
+    cmd->add_option("--width", o.width, "image width")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 16384));
+    cmd->add_option("--height", o.height, "image height")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 16384));
     cmd->add_option("--repeats", o.repeats, "timed runs after a warm-up (median)")
-        ->capture_default_str()->check(CLI::Range(1, 1000));
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1000));
     cmd->add_option("--device", o.device, "device index from `mcrt devices`")
-        ->capture_default_str()->check(CLI::Range(0, 1 << 30));
+        ->capture_default_str()
+        ->check(CLI::Range(0, 1 << 30));
     cmd->add_flag("--json", o.json, "one JSON object per ray kind and line");
     cmd->add_option("--bvh-max-leaf", o.bvh.max_leaf_size, "most triangles in a BVH leaf")
-        ->capture_default_str()->check(CLI::Range(1, 64));
+        ->capture_default_str()
+        ->check(CLI::Range(1, 64));
     cmd->add_option("--bvh-traversal-cost", o.bvh.traversal_cost,
                     "SAH cost of a node visit, in packet tests")
-        ->capture_default_str()->check(kFinite)->check(CLI::Range(0.0f, 100.0f));
+        ->capture_default_str()
+        ->check(kFinite)
+        ->check(CLI::Range(0.0f, 100.0f));
     return cmd;
 }
 
@@ -59,7 +67,8 @@ int run_cli(int argc, char** argv) {
 
     app.add_subcommand("devices", "list OpenCL platforms and devices, with their index");
     bool variants_as_json = false;
-    app.add_subcommand("variants", "list every estimator, light selection, sampler and MIS heuristic")
+    app.add_subcommand("variants",
+                       "list every estimator, light selection, sampler and MIS heuristic")
         ->add_flag("--json", variants_as_json, "as JSON (what the scripts read)");
     RenderOptions render_options;
     add_render_command(app, render_options);

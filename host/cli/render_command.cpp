@@ -2,8 +2,8 @@
 
 #include <cerrno>
 #include <chrono>
-#include <cstring>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -53,7 +53,8 @@ struct InterruptGuard {
         sigaction(SIGINT, &old_int, nullptr);
         sigaction(SIGTERM, &old_term, nullptr);
     }
-    struct sigaction old_int {}, old_term {};
+    struct sigaction old_int {
+    }, old_term{};
 };
 
 glm::vec3 parse_sky(const std::string& text) {
@@ -112,18 +113,26 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
     cmd->add_option("scene", o.scene, "glTF scene (.gltf or .glb)")->required();
     cmd->add_option("--out", o.out, "output EXR")->required();
     cmd->add_option("--png", o.png, "also write an sRGB PNG");
-    cmd->add_option("--width", o.width, "image width")->capture_default_str()->check(CLI::Range(1, 16384));
-    cmd->add_option("--height", o.height, "image height")->capture_default_str()->check(CLI::Range(1, 16384));
-    cmd->add_option("--spp", o.spp, "samples per pixel")->capture_default_str()->check(CLI::Range(1u, 1u << 24));
+    cmd->add_option("--width", o.width, "image width")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 16384));
+    cmd->add_option("--height", o.height, "image height")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 16384));
+    cmd->add_option("--spp", o.spp, "samples per pixel")
+        ->capture_default_str()
+        ->check(CLI::Range(1u, 1u << 24));
     CLI::Option* estimator =
         cmd->add_option("--estimator", o.estimator, help_list("estimator:", kEstimatorVariants))
             ->capture_default_str()
             ->check(CLI::IsMember(variant_names(kEstimatorVariants)));
-    cmd->add_option("--estimator-file", o.estimator_file,
-                    "a user's estimator: an OpenCL C file defining float3 estimate(...) against the "
-                    "kernel API of docs/ESTIMATORS.md")
+    cmd->add_option(
+           "--estimator-file", o.estimator_file,
+           "a user's estimator: an OpenCL C file defining float3 estimate(...) against the "
+           "kernel API of docs/ESTIMATORS.md")
         ->excludes(estimator);
-    cmd->add_option("--light-select", o.light_select, help_list("light selection:", kLightSelectVariants))
+    cmd->add_option("--light-select", o.light_select,
+                    help_list("light selection:", kLightSelectVariants))
         ->capture_default_str()
         ->check(CLI::IsMember(variant_names(kLightSelectVariants)));
     cmd->add_option("--sampler", o.sampler, help_list("sample generator:", kSamplerVariants))
@@ -134,17 +143,26 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
         ->capture_default_str()
         ->check(CLI::IsMember(variant_names(kMisHeuristicVariants)));
     cmd->add_option("--seed", o.seed, "random seed")->capture_default_str();
-    cmd->add_option("--sky", o.sky, "sky radiance R,G,B (ambient estimators)")->capture_default_str();
-    cmd->add_option("--ao-distance", o.ao_distance, "ambient occlusion distance, 0 = unbounded")->capture_default_str()
-        ->check(kFinite)->check(CLI::Range(0.0f, 3.4e38f));
-    cmd->add_option("--camera", o.camera, "camera index in the scene")->check(CLI::Range(0, 1 << 30));
+    cmd->add_option("--sky", o.sky, "sky radiance R,G,B (ambient estimators)")
+        ->capture_default_str();
+    cmd->add_option("--ao-distance", o.ao_distance, "ambient occlusion distance, 0 = unbounded")
+        ->capture_default_str()
+        ->check(kFinite)
+        ->check(CLI::Range(0.0f, 3.4e38f));
+    cmd->add_option("--camera", o.camera, "camera index in the scene")
+        ->check(CLI::Range(0, 1 << 30));
     cmd->add_option("--device", o.devices, "device index, cpu, gpu or all (repeatable)");
-    cmd->add_option("--batch", o.batch, "samples per pixel per launch (0 chooses)")->capture_default_str()
+    cmd->add_option("--batch", o.batch, "samples per pixel per launch (0 chooses)")
+        ->capture_default_str()
         ->check(CLI::Range(0u, 1u << 24));
     cmd->add_option("--stats", o.stats, "write statistics as JSON");
     cmd->add_option("--time-limit", o.time_limit, "stop after this many seconds")
-        ->check(kFinite)->check(CLI::Range(0.0, 1e9));
-    cmd->add_option("--exposure", o.exposure, "PNG exposure in stops")->capture_default_str()->check(kFinite)->check(CLI::Range(-64.0f, 64.0f));
+        ->check(kFinite)
+        ->check(CLI::Range(0.0, 1e9));
+    cmd->add_option("--exposure", o.exposure, "PNG exposure in stops")
+        ->capture_default_str()
+        ->check(kFinite)
+        ->check(CLI::Range(-64.0f, 64.0f));
     cmd->add_flag("--quiet", o.quiet, "no progress output");
     return cmd;
 }
@@ -153,7 +171,8 @@ int run_render(const RenderOptions& o) {
     auto start = std::chrono::steady_clock::now();
     if (o.width * int64_t(o.height) * o.spp >= (int64_t(1) << 40))
         throw InputError("--width × --height × --spp is too large");
-    const std::vector<OutputFile> outputs = {{"--out", o.out}, {"--png", o.png}, {"--stats", o.stats}};
+    const std::vector<OutputFile> outputs = {
+        {"--out", o.out}, {"--png", o.png}, {"--stats", o.stats}};
     std::vector<std::string> inputs = {o.scene};
     if (!o.estimator_file.empty()) inputs.push_back(o.estimator_file);
     check_outputs(outputs, inputs);
@@ -164,8 +183,8 @@ int run_render(const RenderOptions& o) {
     check_host_memory("a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " render",
                       render_host_bytes(o.width, o.height));
     if (scene.triangle_count() == 0) print_warning(o.scene + ": the scene has no triangles");
-    unsigned uses = o.estimator_file.empty() ? estimator_variant(o.estimator).uses
-                                             : kUserEstimatorUses;
+    unsigned uses =
+        o.estimator_file.empty() ? estimator_variant(o.estimator).uses : kUserEstimatorUses;
     if ((uses & kUsesLights) && collect_emitters(scene).empty())
         print_warning(o.scene + ": no emissive triangles: direct lighting is black");
     Camera camera;
@@ -206,7 +225,8 @@ int run_render(const RenderOptions& o) {
                       " of " + std::to_string(o.spp) + " samples per pixel; writing those");
 
     if (uint64_t bad = nonfinite_pixels(result.image))
-        throw RuntimeError(std::to_string(bad) + " pixels are not finite (radiance overflowed single "
+        throw RuntimeError(std::to_string(bad) +
+                           " pixels are not finite (radiance overflowed single "
                            "precision); no image written");
 
     std::map<std::string, std::string> attributes = {
@@ -225,12 +245,15 @@ int run_render(const RenderOptions& o) {
         write_atomically(o.stats, [&](const std::string& tmp) {
             std::ofstream out(tmp);
             out << j.dump(2) << "\n";
-            if (!out) throw RuntimeError(o.stats + ": cannot write: " + std::strerror(errno ? errno : EIO));
+            if (!out)
+                throw RuntimeError(o.stats +
+                                   ": cannot write: " + std::strerror(errno ? errno : EIO));
         });
     }
     if (!o.quiet)
         std::cerr << "mcrt: wrote " << o.out << " (" << o.width << "x" << o.height << ", "
-                  << result.spp << " spp, " << result.seconds_render << " s on the device)" << std::endl;
+                  << result.spp << " spp, " << result.seconds_render << " s on the device)"
+                  << std::endl;
     outputs_complete();
     return 0;
 }

@@ -1,11 +1,10 @@
 // `mcrt render`: its options, their validation, and the render that writes EXR, PNG and stats.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <cstdint>
 #include <string>
 #include <vector>
-
-#include <CLI/CLI.hpp>
 
 namespace mcrt {
 

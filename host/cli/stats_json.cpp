@@ -11,8 +11,8 @@ nlohmann::json render_stats_json(const RenderStatsInput& in) {
     const RenderResult& result = in.result;
     const Bvh& bvh = in.bvh;
     uint64_t samples = uint64_t(o.width) * o.height * result.spp;
-    unsigned uses = o.estimator_file.empty() ? estimator_variant(o.estimator).uses
-                                             : kUserEstimatorUses;
+    unsigned uses =
+        o.estimator_file.empty() ? estimator_variant(o.estimator).uses : kUserEstimatorUses;
     nlohmann::json j = {
         {"scene", o.scene},
         {"width", o.width},
@@ -41,11 +41,16 @@ nlohmann::json render_stats_json(const RenderStatsInput& in) {
         {"triangles", in.scene.triangle_count()},
         {"lights", in.gpu_scene.lights.size()},
         // The 4-wide tree the kernels traverse; the binary SAH tree it collapses as binary_*.
-        {"bvh", {{"nodes", bvh.nodes4.size()}, {"packets", bvh.stats.packets},
-                 {"sah_cost", bvh.stats.sah_cost4}, {"depth", bvh.stats.depth4},
-                 {"bytes", bvh.stats.bytes}, {"binary_nodes", bvh.nodes.size()},
-                 {"binary_sah_cost", bvh.stats.sah_cost}, {"binary_depth", bvh.stats.depth},
-                 {"build_seconds", bvh.stats.build_seconds}}},
+        {"bvh",
+         {{"nodes", bvh.nodes4.size()},
+          {"packets", bvh.stats.packets},
+          {"sah_cost", bvh.stats.sah_cost4},
+          {"depth", bvh.stats.depth4},
+          {"bytes", bvh.stats.bytes},
+          {"binary_nodes", bvh.nodes.size()},
+          {"binary_sah_cost", bvh.stats.sah_cost},
+          {"binary_depth", bvh.stats.depth},
+          {"build_seconds", bvh.stats.build_seconds}}},
     };
     // Image-wide means, so that scripts can compare renders without reading EXR.
     std::array<double, 3> mean{}, mean_variance{};
@@ -59,10 +64,14 @@ nlohmann::json render_stats_json(const RenderStatsInput& in) {
     j["image_mean_variance"] = mean_variance;
     nlohmann::json devices = nlohmann::json::array();
     for (const DeviceReport& d : result.devices)
-        devices.push_back({{"name", d.name}, {"index", d.index}, {"samples", d.samples},
-                           {"batches", d.batches}, {"seconds_busy", d.seconds_busy},
-                           {"retired", d.retired},
-                           {"samples_per_second", d.seconds_busy > 0 ? d.samples / d.seconds_busy : 0.0}});
+        devices.push_back(
+            {{"name", d.name},
+             {"index", d.index},
+             {"samples", d.samples},
+             {"batches", d.batches},
+             {"seconds_busy", d.seconds_busy},
+             {"retired", d.retired},
+             {"samples_per_second", d.seconds_busy > 0 ? d.samples / d.seconds_busy : 0.0}});
     j["devices"] = devices;
     return j;
 }

@@ -1,10 +1,9 @@
 // CLI11 validators the commands share.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <string>
-
-#include <CLI/CLI.hpp>
 
 namespace mcrt {
 

@@ -51,7 +51,8 @@ constexpr double kTargetLaunchSeconds = 0.15;
 
 }  // namespace
 
-void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene, const cl::Buffer& samples) {
+void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene,
+                           const cl::Buffer& samples) {
     CL_CHECK(render.setArg(gpu::RENDER_ARG_NODES, scene.nodes));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_PACKETS, scene.packets));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_TRIANGLE_INFO, scene.triangle_info));
@@ -79,15 +80,14 @@ DeviceWorker::DeviceWorker(const DeviceContext& device, const GpuSceneData& scen
 
     // Batch buffers: at most 2^22 samples (64 MiB; a 150 ms launch needs far fewer on today's
     // devices) or a quarter of an allocation, whichever is less.
-    max_samples_ = std::min<uint64_t>(uint64_t(1) << 22,
-                                      device.info.max_allocation / 4 / sizeof(gpu::float4));
+    max_samples_ =
+        std::min<uint64_t>(uint64_t(1) << 22, device.info.max_allocation / 4 / sizeof(gpu::float4));
     if (fixed_batch_ > 0) max_samples_ = std::max(max_samples_, fixed_batch_);
     uint64_t needed = buffers_->bytes + max_samples_ * sizeof(gpu::float4) * 3;
     if (needed > device.info.global_memory)
-        throw RuntimeError("device '" + device.info.name + "' has " +
-                           std::to_string(device.info.global_memory) +
-                           " bytes of memory; the scene and batch buffers need " +
-                           std::to_string(needed));
+        throw RuntimeError(
+            "device '" + device.info.name + "' has " + std::to_string(device.info.global_memory) +
+            " bytes of memory; the scene and batch buffers need " + std::to_string(needed));
     samples_ = device_buffer(device, CL_MEM_READ_WRITE,
                              round_up(max_samples_, kGroupSize) * sizeof(gpu::float4), "samples");
     // Up to one sum per sample, when spp < one chunk.
@@ -118,8 +118,8 @@ BatchResult DeviceWorker::run(const WorkItem& item) {
                            std::to_string(max_samples_) + " the buffers of '" + report.name +
                            "' hold");
     if (++launches_ == fail_at_launch_)
-        throw ClError("clEnqueueNDRangeKernel (injected by MCRT_FAULT_INJECT)",
-                      CL_OUT_OF_RESOURCES, __FILE__, __LINE__);
+        throw ClError("clEnqueueNDRangeKernel (injected by MCRT_FAULT_INJECT)", CL_OUT_OF_RESOURCES,
+                      __FILE__, __LINE__);
 
     gpu::RenderParams params{};
     params.sky = {settings_.sky.r, settings_.sky.g, settings_.sky.b, 0.0f};

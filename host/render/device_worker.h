@@ -2,10 +2,9 @@
 // kernels, its batch buffers and its measured speed (the scheduler is in renderer.cpp).
 #pragma once
 
+#include <CL/opencl.hpp>
 #include <cstdint>
 #include <memory>
-
-#include <CL/opencl.hpp>
 
 #include "cl/device.h"
 #include "render/accumulator.h"
@@ -17,10 +16,11 @@ namespace mcrt {
 
 // Binds the render kernel's buffers in the order of RenderArgument (kernels/shared_types.h); the
 // per-launch RenderParams are set with each launch.
-void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene, const cl::Buffer& samples);
+void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene,
+                           const cl::Buffer& samples);
 
 class DeviceWorker {
-public:
+  public:
     // Builds the program, uploads the scene and allocates the batch buffers; throws RuntimeError
     // when the device cannot hold them, InputError for a user's estimator that does not build.
     // `fixed_batch_samples` > 0 makes every launch that many samples (--batch).
@@ -39,7 +39,7 @@ public:
 
     DeviceReport report;
 
-private:
+  private:
     const DeviceContext& device_;
     const RenderSettings& settings_;
     uint64_t fixed_batch_;

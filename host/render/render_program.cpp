@@ -25,11 +25,12 @@ std::string render_program_options(const RenderSettings& settings) {
     }
     options += std::string(" -D ") +
                option_variant(kLightSelectVariants, settings.light_select, "--light-select").macro;
-    options += std::string(" -D ") +
-               option_variant(kSamplerVariants, settings.sampler, "--sampler").macro;
+    options +=
+        std::string(" -D ") + option_variant(kSamplerVariants, settings.sampler, "--sampler").macro;
     const OptionVariant& heuristic =
         option_variant(kMisHeuristicVariants, settings.mis_heuristic, "--mis-heuristic");
-    if ((uses & kUsesMisHeuristic) && heuristic.macro) options += std::string(" -D ") + heuristic.macro;
+    if ((uses & kUsesMisHeuristic) && heuristic.macro)
+        options += std::string(" -D ") + heuristic.macro;
     return options;
 }
 
@@ -70,7 +71,8 @@ cl::Program render_program(const DeviceContext& device, const RenderSettings& se
     } catch (const RuntimeError& e) {
         if (settings.estimator_file.empty()) throw;
         std::string what = e.what();
-        std::string error = first_error_in(what.substr(what.find('\n') + 1), settings.estimator_file);
+        std::string error =
+            first_error_in(what.substr(what.find('\n') + 1), settings.estimator_file);
         if (error.empty()) throw;
         throw InputError(error + " (--estimator-file; build log follows)\n" +
                          what.substr(what.find('\n') + 1));
@@ -93,7 +95,8 @@ std::string read_estimator_file(const std::string& path) {
     static const std::regex definition(std::string("\\b") + kUserEstimatorFunction + "\\s*\\(");
     if (!std::regex_search(text.str(), definition))
         throw InputError("--estimator-file " + path + ": defines no function float3 " +
-                         kUserEstimatorFunction + "(const SceneView*, const SurfacePoint*, "
+                         kUserEstimatorFunction +
+                         "(const SceneView*, const SurfacePoint*, "
                          "const SampleStream*, uint*) (docs/ESTIMATORS.md)");
     return text.str();
 }

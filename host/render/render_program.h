@@ -2,9 +2,8 @@
 // user's estimator file in place of kernels/user_estimator.cl, and its build on one device.
 #pragma once
 
-#include <string>
-
 #include <CL/opencl.hpp>
+#include <string>
 
 #include "cl/device.h"
 #include "cl/program.h"

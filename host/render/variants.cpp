@@ -9,14 +9,17 @@ namespace mcrt {
 // DESIGN.md "Estimators"; the kernel functions are in kernels/estimators.cl.
 const std::vector<EstimatorVariant> kEstimatorVariants = {
     {"hemisphere-uniform", "estimate_hemisphere_uniform", kUsesLights,
-     "directions uniform on the hemisphere, pdf 1/(2 pi), counting the emitters they hit (GI Compendium eq. 34)"},
+     "directions uniform on the hemisphere, pdf 1/(2 pi), counting the emitters they hit (GI "
+     "Compendium eq. 34)"},
     {"hemisphere-cosine", "estimate_hemisphere_cosine", kUsesLights,
      "cosine-weighted directions, pdf cos/pi, counting the emitters they hit (eq. 35)"},
     {"light-area", "estimate_light_area", kUsesLights | kUsesLightSelection,
      "a light by --light-select and a uniform point on it, pdf pmf/area converted by cos_y/d^2"},
     {"light-solid-angle", "estimate_light_solid_angle", kUsesLights | kUsesLightSelection,
-     "a light by --light-select and a direction uniform in its spherical triangle (Arvo 1995), area below 3e-4 sr"},
-    {"mis", "estimate_mis", kUsesLights | kUsesLightSelection | kUsesMisHeuristic | kUsesBsdfSampling,
+     "a light by --light-select and a direction uniform in its spherical triangle (Arvo 1995), "
+     "area below 3e-4 sr"},
+    {"mis", "estimate_mis",
+     kUsesLights | kUsesLightSelection | kUsesMisHeuristic | kUsesBsdfSampling,
      "one light-area and one BSDF sample, weighted by --mis-heuristic (Veach 1997)"},
     {"ambient-uniform", "estimate_ambient_uniform", kUsesSky,
      "ambient light: sky visibility over uniform directions, albedo x L_sky x (1/pi) int V cos"},
@@ -29,13 +32,16 @@ const std::vector<EstimatorVariant> kEstimatorVariants = {
 const std::vector<OptionVariant> kLightSelectVariants = {
     {"uniform", "LIGHT_SELECT_UNIFORM", "every light with probability 1/lights"},
     {"power", "LIGHT_SELECT_POWER",
-     "in proportion to emitted power, CDF inversion by binary search (PBRT 13.3.1), on the 2^-24 grid"},
+     "in proportion to emitted power, CDF inversion by binary search (PBRT 13.3.1), on the 2^-24 "
+     "grid"},
     {"alias", "LIGHT_SELECT_ALIAS", "the power distribution by an alias table (Vose 1991), O(1)"},
 };
 
 const std::vector<OptionVariant> kSamplerVariants = {
-    {"independent", "SAMPLER_INDEPENDENT", "independent uniform numbers, pcg4d of (pixel, sample, dimension, seed)"},
-    {"stratified", "SAMPLER_STRATIFIED", "jittered strata per dimension pair, permuted per pixel (Kensler 2013)"},
+    {"independent", "SAMPLER_INDEPENDENT",
+     "independent uniform numbers, pcg4d of (pixel, sample, dimension, seed)"},
+    {"stratified", "SAMPLER_STRATIFIED",
+     "jittered strata per dimension pair, permuted per pixel (Kensler 2013)"},
     {"sobol", "SAMPLER_SOBOL", "Owen-scrambled Sobol' pairs, padded by shuffling (Burley 2020)"},
 };
 
@@ -96,8 +102,10 @@ std::vector<std::string> uses_names(unsigned uses) {
 std::string variants_json() {
     nlohmann::json estimators = nlohmann::json::array();
     for (const EstimatorVariant& row : kEstimatorVariants)
-        estimators.push_back({{"name", row.name}, {"function", row.function},
-                              {"uses", uses_names(row.uses)}, {"description", row.description}});
+        estimators.push_back({{"name", row.name},
+                              {"function", row.function},
+                              {"uses", uses_names(row.uses)},
+                              {"description", row.description}});
     auto options = [](const std::vector<OptionVariant>& table) {
         nlohmann::json rows = nlohmann::json::array();
         for (const OptionVariant& row : table)
@@ -106,12 +114,13 @@ std::string variants_json() {
                             {"description", row.description}});
         return rows;
     };
-    nlohmann::json j = {{"estimators", estimators},
-                        {"light_select", options(kLightSelectVariants)},
-                        {"samplers", options(kSamplerVariants)},
-                        {"mis_heuristics", options(kMisHeuristicVariants)},
-                        {"user_estimator", {{"function", kUserEstimatorFunction},
-                                            {"uses", uses_names(kUserEstimatorUses)}}}};
+    nlohmann::json j = {
+        {"estimators", estimators},
+        {"light_select", options(kLightSelectVariants)},
+        {"samplers", options(kSamplerVariants)},
+        {"mis_heuristics", options(kMisHeuristicVariants)},
+        {"user_estimator",
+         {{"function", kUserEstimatorFunction}, {"uses", uses_names(kUserEstimatorUses)}}}};
     return j.dump(2) + "\n";
 }
 
@@ -126,8 +135,9 @@ std::string variants_text() {
     auto options = [&out](const char* title, const std::vector<OptionVariant>& table) {
         out += title;
         for (const OptionVariant& row : table)
-            out += "  " + std::string(row.name) + std::string(20 - std::string(row.name).size(), ' ') +
-                   row.description + (row.macro ? " [-D " + std::string(row.macro) + "]" : "") + "\n";
+            out += "  " + std::string(row.name) +
+                   std::string(20 - std::string(row.name).size(), ' ') + row.description +
+                   (row.macro ? " [-D " + std::string(row.macro) + "]" : "") + "\n";
     };
     options("light selection (--light-select):\n", kLightSelectVariants);
     options("samplers (--sampler):\n", kSamplerVariants);

@@ -15,9 +15,9 @@ namespace mcrt {
 enum EstimatorUses : unsigned {
     kUsesLights = 1u << 0,          // samples or hits emissive triangles (warn when there are none)
     kUsesLightSelection = 1u << 1,  // chooses among the lights with --light-select
-    kUsesSky = 1u << 2,             // sees the uniform sky (--sky, --ao-distance); camera misses too
-    kUsesMisHeuristic = 1u << 3,    // weights strategies with --mis-heuristic
-    kUsesBsdfSampling = 1u << 4,    // draws directions from the BSDF
+    kUsesSky = 1u << 2,           // sees the uniform sky (--sky, --ao-distance); camera misses too
+    kUsesMisHeuristic = 1u << 3,  // weights strategies with --mis-heuristic
+    kUsesBsdfSampling = 1u << 4,  // draws directions from the BSDF
 };
 
 struct EstimatorVariant {
@@ -53,7 +53,8 @@ std::vector<std::string> variant_names(const std::vector<OptionVariant>& table);
 std::vector<std::string> uses_names(unsigned uses);
 
 // What a user's --estimator-file is assumed to use: lights, their selection and the MIS
-// heuristic (it may call mis_weight); the sky only when the file defines ESTIMATOR_USES_SKY (docs/ESTIMATORS.md).
+// heuristic (it may call mis_weight); the sky only when the file defines ESTIMATOR_USES_SKY
+// (docs/ESTIMATORS.md).
 constexpr unsigned kUserEstimatorUses = kUsesLights | kUsesLightSelection | kUsesMisHeuristic;
 
 // The function a user's estimator file defines.
