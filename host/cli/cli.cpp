@@ -13,6 +13,7 @@
 #include "cli/usage_errors.h"
 #include "cli/validators.h"
 #include "common/error.h"
+#include "mpi/job.h"
 #include "render/variants.h"
 
 namespace mcrt {
@@ -84,7 +85,9 @@ int run_cli(int argc, char** argv) {
     } catch (const CLI::CallForAllHelp& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        std::cerr << "mcrt: error: " << usage_error_message(app, e, argc, argv) << std::endl;
+        // Under mpirun every rank parses the same arguments: rank 0 alone says what is wrong.
+        if (job_rank() == 0)
+            std::cerr << "mcrt: error: " << usage_error_message(app, e, argc, argv) << std::endl;
         return 2;
     }
 

@@ -45,7 +45,26 @@ void ProgressBar::update(uint32_t done, uint32_t total, const std::vector<Device
     for (int k = 0; k < width; ++k) bar[k] = k < filled ? '#' : '.';
     bar[width] = '\0';
     std::string shares;
-    if (devices.size() > 1) {
+    int ranks = 1;
+    for (const DeviceReport& d : devices) ranks = std::max(ranks, d.rank + 1);
+    if (ranks > 1) {
+        // Across MPI ranks: each rank's share (rN), retired when all its devices are.
+        uint64_t all = 0;
+        std::vector<uint64_t> samples(size_t(ranks), 0);
+        std::vector<int> live(size_t(ranks), 0);
+        for (const DeviceReport& d : devices) {
+            all += d.samples;
+            samples[size_t(d.rank)] += d.samples;
+            live[size_t(d.rank)] += d.retired ? 0 : 1;
+        }
+        for (int r = 0; r < ranks; ++r) {
+            char share[48];
+            std::snprintf(share, sizeof share, " r%d:%d%%%s", r,
+                          all ? int(100.0 * samples[size_t(r)] / all + 0.5) : 0,
+                          live[size_t(r)] ? "" : "(retired)");
+            shares += share;
+        }
+    } else if (devices.size() > 1) {
         uint64_t all = 0;
         for (const DeviceReport& d : devices) all += d.samples;
         for (const DeviceReport& d : devices) {

@@ -23,6 +23,7 @@
 #include "common/value_limits.h"
 #include "image/image.h"
 #include "image/image_check.h"
+#include "mpi/job.h"
 #include "render/memory_estimate.h"
 #include "render/render_program.h"
 #include "render/renderer.h"
@@ -85,7 +86,9 @@ std::string help_list(const char* what, const Table& table) {
     return text;
 }
 
-RenderSettings settings_of(const RenderOptions& o) {
+}  // namespace
+
+RenderSettings render_settings(const RenderOptions& o, const std::string* estimator_source) {
     RenderSettings settings;
     settings.width = o.width;
     settings.height = o.height;
@@ -93,7 +96,8 @@ RenderSettings settings_of(const RenderOptions& o) {
     settings.estimator = o.estimator;
     if (!o.estimator_file.empty()) {
         settings.estimator_file = o.estimator_file;
-        settings.estimator_source = read_estimator_file(o.estimator_file);
+        settings.estimator_source =
+            estimator_source ? *estimator_source : read_estimator_file(o.estimator_file);
     }
     settings.light_select = o.light_select;
     settings.sampler = o.sampler;
@@ -106,7 +110,15 @@ RenderSettings settings_of(const RenderOptions& o) {
     return settings;
 }
 
-}  // namespace
+Camera render_camera(const Scene& scene, const RenderOptions& o) {
+    if (o.camera >= 0) {
+        if (size_t(o.camera) >= scene.cameras.size())
+            throw InputError("--camera " + std::to_string(o.camera) + ": " + o.scene + " has " +
+                             std::to_string(scene.cameras.size()) + " perspective camera(s)");
+        return scene.cameras[size_t(o.camera)];
+    }
+    return scene.cameras.empty() ? bench_camera(scene) : scene.cameras.front();
+}
 
 CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
     CLI::App* cmd = app.add_subcommand("render", "render a glTF scene to EXR");
@@ -167,7 +179,10 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
     return cmd;
 }
 
-int run_render(const RenderOptions& o) {
+namespace {
+
+// The command on rank 0 (or alone): with a job, the other ranks get the inputs and render too.
+int render_here(const RenderOptions& o, RenderJob* job) {
     auto start = std::chrono::steady_clock::now();
     if (o.width * int64_t(o.height) * o.spp >= (int64_t(1) << 40))
         throw InputError("--width × --height × --spp is too large");
@@ -176,9 +191,10 @@ int run_render(const RenderOptions& o) {
     std::vector<std::string> inputs = {o.scene};
     if (!o.estimator_file.empty()) inputs.push_back(o.estimator_file);
     check_outputs(outputs, inputs);
-    RenderSettings settings = settings_of(o);
+    RenderSettings settings = render_settings(o);
 
-    Scene scene = load_gltf(o.scene, print_warning, &inputs);
+    FileBundle files;  // what the other ranks load the scene from
+    Scene scene = load_gltf(o.scene, print_warning, &inputs, job ? &files : nullptr);
     check_outputs(outputs, inputs);  // its buffers too
     check_host_memory("a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " render",
                       render_host_bytes(o.width, o.height));
@@ -187,14 +203,10 @@ int run_render(const RenderOptions& o) {
         o.estimator_file.empty() ? estimator_variant(o.estimator).uses : kUserEstimatorUses;
     if ((uses & kUsesLights) && collect_emitters(scene).empty())
         print_warning(o.scene + ": no emissive triangles: direct lighting is black");
-    Camera camera;
-    if (o.camera >= 0) {
-        if (size_t(o.camera) >= scene.cameras.size())
-            throw InputError("--camera " + std::to_string(o.camera) + ": " + o.scene + " has " +
-                             std::to_string(scene.cameras.size()) + " perspective camera(s)");
-        camera = scene.cameras[size_t(o.camera)];
-    } else {
-        camera = scene.cameras.empty() ? bench_camera(scene) : scene.cameras.front();
+    Camera camera = render_camera(scene, o);
+    if (job) {
+        job->share_inputs(files, settings.estimator_source);
+        files.clear();
     }
 
     std::vector<DeviceInfo> devices = select_devices(o.devices, print_warning);
@@ -218,7 +230,7 @@ int run_render(const RenderOptions& o) {
         [&](uint32_t done, uint32_t total, const std::vector<DeviceReport>& d) {
             bar.update(done, total, d);
         },
-        control, print_warning);
+        control, print_warning, job ? job->remote_workers(print_warning) : RemoteWorkers{});
     bar.finish();
     if (!result.stopped_by.empty())
         print_warning("stopped by " + result.stopped_by + " after " + std::to_string(result.spp) +
@@ -242,6 +254,7 @@ int run_render(const RenderOptions& o) {
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!o.stats.empty()) {
         nlohmann::json j = render_stats_json({o, settings, scene, bvh, gpu_scene, result, total});
+        if (job) j["ranks"] = job->ranks_json(result.devices);
         write_atomically(o.stats, [&](const std::string& tmp) {
             std::ofstream out(tmp);
             out << j.dump(2) << "\n";
@@ -256,6 +269,26 @@ int run_render(const RenderOptions& o) {
                   << std::endl;
     outputs_complete();
     return 0;
+}
+
+}  // namespace
+
+int run_render(const RenderOptions& o) {
+    if (job_size() == 1) return render_here(o, nullptr);
+    if (job_rank() > 0) return serve_render(o);
+    // Every rank exits with rank 0's status; its error line is printed by run_cli alone.
+    RenderJob job;
+    try {
+        const int status = render_here(o, &job);
+        job.finish(status);
+        return status;
+    } catch (const InputError&) {
+        job.finish(2);
+        throw;
+    } catch (...) {
+        job.finish(1);
+        throw;
+    }
 }
 
 }  // namespace mcrt

@@ -6,6 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "render/renderer.h"
+#include "scene/scene.h"
+
 namespace mcrt {
 
 struct RenderOptions {
@@ -29,6 +32,14 @@ struct RenderOptions {
 CLI::App* add_render_command(CLI::App& app, RenderOptions& o);
 
 // Runs it; returns the exit status, throws InputError / RuntimeError (run_cli prints them).
+// Under mpirun or srun, rank 0 runs the command and the other ranks render with it
+// (host/mpi/job.h).
 int run_render(const RenderOptions& o);
+
+// What every rank of an MPI render derives alike from the options: the settings (given
+// `estimator_source`, that is the text of --estimator-file, not read again) and the camera.
+RenderSettings render_settings(const RenderOptions& o,
+                               const std::string* estimator_source = nullptr);
+Camera render_camera(const Scene& scene, const RenderOptions& o);
 
 }  // namespace mcrt

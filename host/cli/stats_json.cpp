@@ -71,6 +71,7 @@ nlohmann::json render_stats_json(const RenderStatsInput& in) {
              {"batches", d.batches},
              {"seconds_busy", d.seconds_busy},
              {"retired", d.retired},
+             {"rank", d.rank},
              {"samples_per_second", d.seconds_busy > 0 ? d.samples / d.seconds_busy : 0.0}});
     j["devices"] = devices;
     return j;

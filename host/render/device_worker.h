@@ -9,6 +9,7 @@
 #include "cl/device.h"
 #include "render/accumulator.h"
 #include "render/gpu_scene.h"
+#include "render/render_worker.h"
 #include "render/renderer.h"
 #include "render/work_queue.h"
 
@@ -19,7 +20,7 @@ namespace mcrt {
 void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene,
                            const cl::Buffer& samples);
 
-class DeviceWorker {
+class DeviceWorker : public RenderWorker {
   public:
     // Builds the program, uploads the scene and allocates the batch buffers; throws RuntimeError
     // when the device cannot hold them, InputError for a user's estimator that does not build.
@@ -29,15 +30,13 @@ class DeviceWorker {
 
     // Samples the next launch should hold: a fixed --batch, else a probe, then what the
     // measured speed does in about 150 ms.
-    uint64_t target_samples() const;
+    uint64_t target_samples() const override;
 
     // Renders and reduces one work item; throws RuntimeError when the device fails.
-    BatchResult run(const WorkItem& item);
+    BatchResult run(const WorkItem& item) override;
 
     // Adds the last successful launch to the report; the caller holds the render's lock.
-    void commit_report();
-
-    DeviceReport report;
+    void commit_report() override;
 
   private:
     const DeviceContext& device_;

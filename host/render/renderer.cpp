@@ -10,6 +10,7 @@
 #include "render/accumulator.h"
 #include "render/device_worker.h"
 #include "render/render_program.h"
+#include "render/render_worker.h"
 #include "render/work_queue.h"
 
 namespace mcrt {
@@ -26,7 +27,8 @@ uint32_t batch_samples_per_pixel(uint32_t requested, int width, int height, uint
 RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuSceneData& scene,
                     const RenderSettings& settings, const ProgressSink& progress,
                     const RenderControl& control,
-                    const std::function<void(const std::string&)>& warn) {
+                    const std::function<void(const std::string&)>& warn,
+                    const RemoteWorkers& remote) {
     auto start = std::chrono::steady_clock::now();
     render_program_options(settings);  // rejects unknown settings before any device work
     const uint32_t pixels = uint32_t(settings.width) * uint32_t(settings.height);
@@ -37,17 +39,19 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
             : 0;
 
     // Set up every device; one that cannot hold the scene is skipped with a warning.
-    std::vector<std::unique_ptr<DeviceWorker>> workers;
+    std::vector<std::unique_ptr<RenderWorker>> workers;
     std::string last_error;
     for (const DeviceContext* d : devices) {
         try {
             workers.push_back(std::make_unique<DeviceWorker>(*d, scene, settings, fixed_batch));
         } catch (const RuntimeError& e) {
-            if (devices.size() == 1) throw;
+            if (devices.size() == 1 && !remote) throw;
             last_error = e.what();
             if (warn) warn("skipping device " + std::to_string(d->info.index) + " ('" + d->info.name + "'): " + e.what());
         }
     }
+    if (remote)
+        for (auto& w : remote()) workers.push_back(std::move(w));
     if (workers.empty()) throw RuntimeError("no device can render this scene: " + last_error);
 
     RenderResult result;
@@ -61,7 +65,7 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
         for (const auto& w : workers) r.push_back(w->report);
         return r;
     };
-    auto device_loop = [&](DeviceWorker& worker, std::optional<WorkItem> item) {
+    auto device_loop = [&](RenderWorker& worker, std::optional<WorkItem> item) {
         for (; item; item = queue.take(worker.target_samples())) {
             BatchResult r;
             try {
@@ -69,7 +73,9 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
             } catch (const RuntimeError& e) {
                 std::lock_guard<std::mutex> lock(acc_mutex);
                 worker.report.retired = true;
-                if (warn) warn("device " + std::to_string(worker.report.index) + " ('" + worker.report.name + "') failed and is retired; its work is redone on the other devices: " + e.what());
+                const std::string rank =
+                    worker.report.rank > 0 ? "rank " + std::to_string(worker.report.rank) + " " : "";
+                if (warn) warn(rank + "device " + std::to_string(worker.report.index) + " ('" + worker.report.name + "') failed and is retired; its work is redone on the other devices: " + e.what());
                 queue.give_back(*item);
                 return;
             }

@@ -4,6 +4,7 @@
 #include <csignal>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -38,7 +39,13 @@ struct DeviceReport {
     uint64_t batches = 0;
     double seconds_busy = 0;  // kernel time from profiling events
     bool retired = false;     // failed during the render; its work was redone elsewhere
+    int rank = 0;             // the MPI rank it belongs to (0 without MPI)
 };
+
+class RenderWorker;  // render/render_worker.h
+// Called once the local devices are set up: devices of other MPI ranks that render beside them
+// (host/mpi/), or none.
+using RemoteWorkers = std::function<std::vector<std::unique_ptr<RenderWorker>>()>;
 
 struct RenderResult {
     Image image;
@@ -65,11 +72,13 @@ struct RenderControl {
 // to take about 150 ms; a device that fails is retired with a warning and its work redone on the
 // others. The image is bitwise identical whatever the devices, batch sizes and timing (for
 // devices that round identically). Throws InputError for settings it cannot honour,
-// RuntimeError when no device can render.
+// RuntimeError when no device can render. `remote` adds the devices of other MPI ranks, handed
+// work from the same queue.
 RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuSceneData& scene,
                     const RenderSettings& settings, const ProgressSink& progress = {},
                     const RenderControl& control = {},
-                    const std::function<void(const std::string&)>& warn = {});
+                    const std::function<void(const std::string&)>& warn = {},
+                    const RemoteWorkers& remote = {});
 
 // One device, no early stop.
 RenderResult render(const DeviceContext& device, const GpuSceneData& scene,

@@ -162,7 +162,26 @@ struct DiskAccess {
     std::string base_prefix;            // the scene's directory and "/"
     std::vector<std::string> files_read;
     std::string first_refusal;          // refusals of optional files (images) tinygltf drops
+    FileBundle* record = nullptr;       // keeps a copy of what is read (load_gltf's `record`)
+    const FileBundle* source = nullptr; // read from here instead of the disk (from a bundle)
 };
+
+// One file, from the bundle when there is one, else from the disk (recorded when asked).
+bool read_scene_file(DiskAccess& access, const std::string& path, std::vector<unsigned char>& out,
+                     std::string& why) {
+    if (access.source) {
+        auto it = access.source->find(path);
+        if (it == access.source->end()) {
+            why = "not among the files of the bundle";
+            return false;
+        }
+        out = it->second;
+        return true;
+    }
+    if (!read_regular_file(path, out, why, kMaxFileBytes)) return false;
+    if (access.record) (*access.record)[path] = out;
+    return true;
+}
 
 bool disk_file_exists(const std::string& path, void* user) {
     // Claim the first candidate exists so the reader names why it cannot be read.
@@ -173,7 +192,7 @@ bool disk_file_read(std::vector<unsigned char>* out, std::string* error, const s
                     void* user) {
     auto* access = static_cast<DiskAccess*>(user);
     std::string why;
-    if (!read_regular_file(path, *out, why, kMaxFileBytes)) {
+    if (!read_scene_file(*access, path, *out, why)) {
         if (error) *error = why;
         if (access->first_refusal.empty()) access->first_refusal = path + ": " + why;
         return false;
@@ -188,10 +207,11 @@ bool disk_no_write(std::string* error, const std::string&, const std::vector<uns
     return false;
 }
 
-tinygltf::Model read_model(const std::string& path, std::vector<std::string>* files_read) {
+tinygltf::Model read_model(const std::string& path, std::vector<std::string>* files_read,
+                           DiskAccess access = {}) {
     std::vector<unsigned char> bytes;
     std::string why;
-    if (!read_regular_file(path, bytes, why, kMaxFileBytes)) {
+    if (!read_scene_file(access, path, bytes, why)) {
         throw InputError(path + ": cannot open: " + why);
     }
     if (bytes.empty()) throw InputError(path + ": the file is empty");
@@ -207,7 +227,6 @@ tinygltf::Model read_model(const std::string& path, std::vector<std::string>* fi
 
     std::string base_dir = std::filesystem::path(path).parent_path().string();
     if (base_dir.empty()) base_dir = ".";
-    DiskAccess access;
     access.base_prefix = base_dir + "/";
     tinygltf::TinyGLTF loader = make_loader();
     loader.SetFsCallbacks(tinygltf::FsCallbacks{disk_file_exists, disk_path_unchanged,
@@ -1131,8 +1150,19 @@ void Importer::warn_unsupported_model_parts() {
 }  // namespace
 
 Scene load_gltf(const std::string& path, const WarningSink& warn,
-                std::vector<std::string>* files_read) {
-    const tinygltf::Model model = read_model(path, files_read);
+                std::vector<std::string>* files_read, FileBundle* record) {
+    DiskAccess access;
+    access.record = record;
+    const tinygltf::Model model = read_model(path, files_read, std::move(access));
+    Diagnostics diag(path, warn);
+    return Importer(model, diag).import_default_scene(path);
+}
+
+Scene load_gltf_from_bundle(const std::string& path, const FileBundle& files,
+                            const WarningSink& warn) {
+    DiskAccess access;
+    access.source = &files;
+    const tinygltf::Model model = read_model(path, nullptr, std::move(access));
     Diagnostics diag(path, warn);
     return Importer(model, diag).import_default_scene(path);
 }

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -18,8 +19,19 @@ using WarningSink = std::function<void(const std::string&)>;
 // With `files_read`, the paths of the scene file and of every external file read for it are
 // appended (outputs must not replace them). Only regular files are read; a FIFO, directory or
 // device, as the scene or a uri, is refused naming what it is.
+// The bytes of the files one load read, by the path it read them under (the scene file and its
+// external buffers and images): rank 0 of an MPI render records them and sends them to the other
+// ranks, which load the same scene from them without a shared file system.
+using FileBundle = std::map<std::string, std::vector<unsigned char>>;
+
+// With `record`, a copy of every file read is also kept there.
 Scene load_gltf(const std::string& path, const WarningSink& warn,
-                std::vector<std::string>* files_read = nullptr);
+                std::vector<std::string>* files_read = nullptr, FileBundle* record = nullptr);
+
+// Loads `path` as load_gltf does, but every file (the scene's too) comes from `files`; a path
+// absent from it cannot be read. The same bundle gives the same scene on every rank.
+Scene load_gltf_from_bundle(const std::string& path, const FileBundle& files,
+                            const WarningSink& warn);
 
 // The same from the bytes of a .gltf or .glb file (GLB when they start with "glTF" or `name`
 // ends in .glb); `name` stands for the file in messages. Nothing is read from disk: buffers and

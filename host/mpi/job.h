@@ -1,0 +1,64 @@
+// One render across the processes of an MPI job (docs/MPI.md). Built with MPI when CMake finds
+// it (MCRT_HAVE_MPI); without it, or when mcrt is not started by mpirun or srun, every process is
+// a job of one and renders as it always has.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli/render_command.h"
+#include "render/renderer.h"
+#include "scene/gltf_import.h"
+
+namespace mcrt {
+
+// Joins the MPI job for the life of the process when an MPI launcher started it (mpirun's
+// OMPI_COMM_WORLD_SIZE, PMIx's PMIX_RANK or PMI's PMI_RANK in the environment); otherwise does
+// nothing, so a plain `mcrt` never initialises MPI.
+class JobSession {
+  public:
+    JobSession();
+    ~JobSession();
+    JobSession(const JobSession&) = delete;
+    JobSession& operator=(const JobSession&) = delete;
+};
+
+int job_rank();  // this process's rank; 0 outside a job
+int job_size();  // processes in the job; 1 outside one
+
+// Rank 0's side of a render across the job: it sends the inputs, hands every other rank's devices
+// work items (RemoteWorker) beside its own, and tells the ranks how the command ended.
+class RenderJob {
+  public:
+    RenderJob();
+    ~RenderJob();
+    RenderJob(const RenderJob&) = delete;
+    RenderJob& operator=(const RenderJob&) = delete;
+
+    // Broadcasts the scene's files and the estimator's text (after rank 0 checked them).
+    void share_inputs(const FileBundle& files, const std::string& estimator_source);
+
+    // For render(): waits for every rank's setup and returns one worker per device of theirs;
+    // prints the ranks' setup warnings through `warn`.
+    RemoteWorkers remote_workers(std::function<void(const std::string&)> warn);
+
+    // `ranks` of the stats JSON: per rank, its host, devices, samples, items and busy time.
+    nlohmann::json ranks_json(const std::vector<DeviceReport>& devices) const;
+
+    // The command's exit status, to every rank (they exit with it); then the job is over.
+    void finish(int status);
+
+  private:
+    struct State;
+    std::unique_ptr<State> state_;
+};
+
+// Every rank but 0: receives the inputs, sets up its devices, renders the items rank 0 hands
+// them until told to stop, and returns rank 0's exit status. Prints nothing: what goes wrong
+// here reaches rank 0 as a warning (a setup that fails, a device that fails) and its status.
+int serve_render(const RenderOptions& o);
+
+}  // namespace mcrt

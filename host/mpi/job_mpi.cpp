@@ -1,0 +1,279 @@
+// A render across the ranks of an MPI job (docs/MPI.md): the session, rank 0's RenderJob and the
+// other ranks' serve_render. Message by message:
+//   1. rank 0 → all (broadcast): a status (0 = go, else rank 0's exit status: stop now), then
+//      the scene's files and the estimator's text;
+//   2. each rank → 0: a hello (host, the devices it set up, its warnings);
+//   3. per device slot: rank 0 → r an item or a stop; r → 0 the item's sums or its failure;
+//   4. rank 0 → all (broadcast): the command's exit status.
+#include <mpi.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <thread>
+
+#include "bvh/bvh.h"
+#include "cli/device_select.h"
+#include "common/error.h"
+#include "mpi/job.h"
+#include "mpi/mpi_comm.h"
+#include "mpi/remote_worker.h"
+#include "mpi/wire.h"
+#include "render/device_worker.h"
+
+namespace mcrt {
+namespace {
+
+int g_rank = 0, g_size = 1;
+bool g_joined = false;
+
+bool launched_by_mpi() {
+    for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})
+        if (std::getenv(name)) return true;
+    return false;
+}
+
+}  // namespace
+
+JobSession::JobSession() {
+    if (!launched_by_mpi()) return;
+    int provided = MPI_THREAD_SINGLE;
+    if (MPI_Init_thread(nullptr, nullptr, MPI_THREAD_MULTIPLE, &provided) != MPI_SUCCESS) {
+        std::fprintf(stderr, "mcrt: error: MPI_Init_thread failed\n");
+        std::exit(1);
+    }
+    g_joined = true;
+    MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &g_size);
+    // Every rank's device threads send and receive at once.
+    if (g_size > 1 && provided < MPI_THREAD_MULTIPLE) {
+        if (g_rank == 0)
+            std::fprintf(stderr, "mcrt: error: the MPI library does not support "
+                                 "MPI_THREAD_MULTIPLE, which a render across ranks needs\n");
+        MPI_Finalize();
+        std::exit(1);
+    }
+}
+
+JobSession::~JobSession() {
+    if (g_joined) MPI_Finalize();
+}
+
+int job_rank() { return g_rank; }
+int job_size() { return g_size; }
+
+// ---------------------------------------------------------------------------------------------
+// Rank 0
+// ---------------------------------------------------------------------------------------------
+
+struct RenderJob::State {
+    bool inputs_sent = false, hellos_received = false, finished = false;
+    std::vector<std::string> hosts;
+    std::vector<int> devices_set_up;
+    std::vector<RankTraffic> traffic;  // per rank; RemoteWorkers count into it
+
+    // Every other rank's hello; the workers for their devices go to `workers`.
+    void receive_hellos(const std::function<void(const std::string&)>& warn,
+                        std::vector<std::unique_ptr<RenderWorker>>& workers) {
+        for (int r = 1; r < g_size; ++r) {
+            const wire::Hello hello = wire::decode_hello(mpi::receive_bytes(r, mpi::kHelloTag));
+            hosts[size_t(r)] = hello.host;
+            devices_set_up[size_t(r)] = int(hello.devices.size());
+            const std::string who = "rank " + std::to_string(r) + " (" + hello.host + ")";
+            for (const std::string& w : hello.warnings)
+                if (warn) warn(who + ": " + w);
+            if (hello.devices.empty() && warn)
+                warn(who + " renders nothing: none of its devices could be set up");
+            for (size_t slot = 0; slot < hello.devices.size(); ++slot)
+                workers.push_back(std::make_unique<RemoteWorker>(
+                    r, int(slot), hello.devices[slot].first, hello.devices[slot].second,
+                    &traffic[size_t(r)]));
+        }
+        hellos_received = true;
+    }
+};
+
+RenderJob::RenderJob() : state_(std::make_unique<State>()) {
+    state_->hosts.assign(size_t(g_size), "");
+    state_->hosts[0] = mpi::host_name();
+    state_->devices_set_up.assign(size_t(g_size), 0);
+    state_->traffic.resize(size_t(g_size));
+}
+
+RenderJob::~RenderJob() {
+    try {
+        finish(1);  // no-op after finish(); else the other ranks are not left waiting
+    } catch (const std::exception&) {
+    }
+}
+
+void RenderJob::share_inputs(const FileBundle& files, const std::string& estimator_source) {
+    wire::Bytes bytes = wire::encode_inputs(files, estimator_source);
+    mpi::broadcast_u64(0, 0);  // go
+    mpi::broadcast_bytes(bytes, 0);
+    state_->inputs_sent = true;
+}
+
+RemoteWorkers RenderJob::remote_workers(std::function<void(const std::string&)> warn) {
+    return [this, warn] {
+        std::vector<std::unique_ptr<RenderWorker>> workers;
+        state_->receive_hellos(warn, workers);
+        return workers;
+    };
+}
+
+nlohmann::json RenderJob::ranks_json(const std::vector<DeviceReport>& devices) const {
+    nlohmann::json ranks = nlohmann::json::array();
+    for (int r = 0; r < g_size; ++r) {
+        int count = 0, retired = 0;
+        uint64_t samples = 0, items = 0;
+        double busy = 0;
+        for (const DeviceReport& d : devices) {
+            if (d.rank != r) continue;
+            ++count;
+            retired += d.retired ? 1 : 0;
+            samples += d.samples;
+            items += d.batches;
+            busy += d.seconds_busy;
+        }
+        const RankTraffic& t = state_->traffic[size_t(r)];
+        ranks.push_back({{"rank", r},
+                         {"host", state_->hosts[size_t(r)]},
+                         {"devices", count},
+                         {"devices_retired", retired},
+                         {"samples", samples},
+                         {"items", items},
+                         {"seconds_busy", busy},
+                         {"message_bytes", t.bytes},
+                         {"seconds_message_overhead", t.seconds_overhead}});
+    }
+    return ranks;
+}
+
+void RenderJob::finish(int status) {
+    State& s = *state_;
+    if (s.finished) return;
+    s.finished = true;
+    if (!s.inputs_sent) {
+        mpi::broadcast_u64(uint64_t(status == 0 ? 1 : status), 0);  // stop before any work
+        return;
+    }
+    if (!s.hellos_received) {
+        // Rank 0 failed before its render started: stop every device the others set up.
+        std::vector<std::unique_ptr<RenderWorker>> workers;
+        s.receive_hellos({}, workers);
+    }  // else the RemoteWorkers told their devices when render() destroyed them
+    mpi::broadcast_u64(uint64_t(status), 0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The other ranks
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+// One device's loop: items from rank 0 until a stop; a failure is sent back and ends it.
+void serve_device(RenderWorker& worker, int slot) {
+    for (;;) {
+        const std::optional<WorkItem> item =
+            wire::decode_item(mpi::receive_bytes(0, mpi::item_tag(slot)));
+        if (!item) return;
+        wire::ResultMessage m;
+        try {
+            const uint64_t samples = worker.report.samples;
+            const double busy = worker.report.seconds_busy;
+            auto start = std::chrono::steady_clock::now();
+            m.result = worker.run(*item);
+            m.seconds_run =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            worker.commit_report();
+            m.samples = worker.report.samples - samples;
+            m.seconds_busy = worker.report.seconds_busy - busy;
+            m.target_samples = worker.target_samples();
+        } catch (const std::exception& e) {
+            m = wire::ResultMessage{};
+            m.failed = true;
+            m.error = e.what();
+        }
+        mpi::send_bytes(wire::encode_result(m), 0, mpi::result_tag(slot));
+        if (m.failed) return;
+    }
+}
+
+}  // namespace
+
+int serve_render(const RenderOptions& o) {
+    // Rank 0 decides when the render stops (its signals, its time limit) and tells every rank;
+    // mpirun's SIGTERM to all ranks at Ctrl-C must not end this one before rank 0 has the
+    // samples it is rendering.
+    std::signal(SIGINT, SIG_IGN);
+    std::signal(SIGTERM, SIG_IGN);
+
+    const uint64_t go = mpi::broadcast_u64(0, 0);
+    if (go != 0) return int(go);
+    wire::Bytes bytes;
+    mpi::broadcast_bytes(bytes, 0);
+
+    wire::Hello hello;
+    hello.host = mpi::host_name();
+    auto warn = [&](const std::string& w) { hello.warnings.push_back(w); };
+    RenderSettings settings;
+    GpuSceneData gpu_scene;
+    std::vector<std::unique_ptr<DeviceContext>> contexts;
+    std::vector<std::unique_ptr<DeviceWorker>> workers;
+    try {
+        FileBundle files;
+        std::string estimator_source;
+        wire::decode_inputs(bytes, files, estimator_source);
+        bytes = {};
+        settings = render_settings(o, &estimator_source);
+        Scene scene = load_gltf_from_bundle(o.scene, files, {});  // rank 0 printed its warnings
+        files.clear();
+        const Camera camera = render_camera(scene, o);
+        const std::vector<DeviceInfo> devices = select_devices(o.devices, warn);
+        Bvh bvh = build_bvh(scene);
+        gpu_scene = make_gpu_scene(scene, bvh, camera, o.width, o.height);
+        const uint64_t fixed_batch =
+            settings.batch > 0 ? uint64_t(settings.width) * settings.height *
+                                     batch_samples_per_pixel(settings.batch, settings.width,
+                                                             settings.height, settings.spp)
+                               : 0;
+        if (devices.size() > size_t(mpi::kMaxSlots))
+            throw RuntimeError("more than " + std::to_string(mpi::kMaxSlots) + " devices");
+        for (const DeviceInfo& d : devices) {
+            try {
+                contexts.push_back(std::make_unique<DeviceContext>(d));
+                workers.push_back(std::make_unique<DeviceWorker>(*contexts.back(), gpu_scene,
+                                                                 settings, fixed_batch));
+            } catch (const std::exception& e) {
+                warn("skipping device " + std::to_string(d.index) + " ('" + d.name + "'): " +
+                     e.what());
+            }
+        }
+    } catch (const std::exception& e) {
+        warn(e.what());
+        workers.clear();
+    }
+    for (const auto& w : workers) {
+        hello.devices.emplace_back(w->report.index, w->report.name);
+    }
+    mpi::send_bytes(wire::encode_hello(hello), 0, mpi::kHelloTag);
+
+    std::vector<std::thread> threads;
+    for (size_t slot = 0; slot < workers.size(); ++slot)
+        threads.emplace_back([&, slot] {
+            try {
+                serve_device(*workers[slot], int(slot));
+            } catch (const std::exception& e) {  // a message rank 0 did not send: a bug
+                std::fprintf(stderr, "mcrt: error: rank %d: %s\n", g_rank, e.what());
+                MPI_Abort(MPI_COMM_WORLD, 1);
+            }
+        });
+    for (std::thread& t : threads) t.join();
+    return int(mpi::broadcast_u64(0, 0));
+}
+
+}  // namespace mcrt

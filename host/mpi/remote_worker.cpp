@@ -1,0 +1,56 @@
+#include "mpi/remote_worker.h"
+
+#include <chrono>
+
+#include "common/error.h"
+#include "mpi/mpi_comm.h"
+#include "mpi/wire.h"
+
+namespace mcrt {
+
+RemoteWorker::RemoteWorker(int rank, int slot, int index, const std::string& name,
+                           RankTraffic* traffic)
+    : rank_(rank), slot_(slot), traffic_(traffic) {
+    report.rank = rank;
+    report.index = index;
+    report.name = name;
+}
+
+RemoteWorker::~RemoteWorker() {
+    if (failed_) return;
+    try {
+        mpi::send_bytes(wire::encode_item(std::nullopt), rank_, mpi::item_tag(slot_));
+    } catch (const std::exception&) {
+        // MPI's own errors end the job (MPI_ERRORS_ARE_FATAL): nothing is left to tell.
+    }
+}
+
+BatchResult RemoteWorker::run(const WorkItem& item) {
+    auto start = std::chrono::steady_clock::now();
+    const wire::Bytes request = wire::encode_item(item);
+    mpi::send_bytes(request, rank_, mpi::item_tag(slot_));
+    const wire::Bytes reply = mpi::receive_bytes(rank_, mpi::result_tag(slot_));
+    double round_trip =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    wire::ResultMessage m = wire::decode_result(reply, item);
+    if (m.failed) {
+        failed_ = true;  // that rank's device thread has ended
+        throw RuntimeError(m.error);
+    }
+    target_ = m.target_samples;
+    pending_samples_ = m.samples;
+    pending_busy_ = m.seconds_busy;
+    pending_bytes_ = request.size() + reply.size();
+    pending_overhead_ = std::max(0.0, round_trip - m.seconds_run);
+    return std::move(m.result);
+}
+
+void RemoteWorker::commit_report() {
+    report.seconds_busy += pending_busy_;
+    report.samples += pending_samples_;
+    report.batches += 1;
+    traffic_->bytes += pending_bytes_;
+    traffic_->seconds_overhead += pending_overhead_;
+}
+
+}  // namespace mcrt

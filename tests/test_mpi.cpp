@@ -1,0 +1,353 @@
+// One render across the ranks of an MPI job (docs/MPI.md): the image must be bitwise identical to
+// a one-process render, every rank must do work, a time limit, a signal to rank 0 and a device
+// fault on one rank must behave as they do on one machine, bad input must end every rank with
+// one error line, and the death of a rank must end the job rather than hang it. Skipped when mcrt
+// was built without MPI or mpirun is not installed; the message format is tested in every build.
+#include <catch2/catch.hpp>
+
+#include <dirent.h>
+
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "common/error.h"
+#include "image/image.h"
+#include "mpi/wire.h"
+#include "process_support.h"
+#include "test_support.h"
+
+using namespace mcrt;
+using namespace mcrt::test;
+
+namespace {
+
+const std::string kCornell = std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf";
+
+// mpirun on PATH, or a skip: when mcrt was built without MPI, or MPI is not installed.
+std::string mpirun() {
+#ifndef MCRT_HAVE_MPI
+    skip_test("mcrt was built without MPI (CMake found none)");
+#endif
+    const char* path = std::getenv("PATH");
+    std::string dirs = path ? path : "/usr/bin:/bin";
+    for (size_t at = 0; at <= dirs.size();) {
+        size_t end = dirs.find(':', at);
+        if (end == std::string::npos) end = dirs.size();
+        std::string candidate = dirs.substr(at, end - at) + "/mpirun";
+        if (::access(candidate.c_str(), X_OK) == 0) return candidate;
+        at = end + 1;
+    }
+    skip_test("mpirun is not installed (Debian: openmpi-bin)");
+}
+
+// For every child: root may run mpirun (CI runs as root), ranks oversubscribe the two cores, and
+// no single-copy mechanism between ranks (CMA's process_vm_readv is refused in containers).
+const bool mpi_environment = [] {
+    setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+    setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+    setenv("OMPI_MCA_btl_vader_single_copy_mechanism", "none", 1);
+    setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 1);
+    unsetenv("MCRT_FAULT_INJECT");
+    unsetenv("POCL_DEVICES");
+    return true;
+}();
+
+bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
+
+std::vector<std::string> render_args(const std::string& out, std::vector<std::string> extra = {}) {
+    std::vector<std::string> a = {"render", kCornell, "--width", "48", "--height", "40",
+                                  "--spp", "64", "--quiet", "--out", out};
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+}
+
+// `mpirun -n ranks mcrt ARGS...`
+ProcessResult run_mpi(int ranks, const std::vector<std::string>& mcrt_args, const TempDir& dir,
+                      double timeout = 60) {
+    std::vector<std::string> a = {"--oversubscribe", "-n", std::to_string(ranks), MCRT_EXE};
+    a.insert(a.end(), mcrt_args.begin(), mcrt_args.end());
+    return run_process(mpirun(), a, dir.path(), timeout);
+}
+
+// The pids of the mcrt processes of an mpirun whose environment holds `marker` (the test's own
+// MCRT_TEST_MPI_MARKER value), with their rank.
+std::vector<std::pair<int, pid_t>> ranks_with_marker(const std::string& marker) {
+    std::vector<std::pair<int, pid_t>> found;
+    DIR* proc = opendir("/proc");
+    if (!proc) return found;
+    while (dirent* e = readdir(proc)) {
+        pid_t pid = std::atoi(e->d_name);
+        if (pid <= 0) continue;
+        std::string env = read_whole_file("/proc/" + std::to_string(pid) + "/environ");
+        if (env.find("MCRT_TEST_MPI_MARKER=" + marker + '\0') == std::string::npos) continue;
+        const std::string key = std::string("OMPI_COMM_WORLD_RANK=");
+        size_t at = env.find(key);
+        if (at == std::string::npos) continue;
+        found.emplace_back(std::atoi(env.c_str() + at + key.size()), pid);
+    }
+    closedir(proc);
+    return found;
+}
+
+// Sends `signal` to rank `rank` of the job marked `marker` once it has rendered for a while
+// (`after` seconds after that rank appears).
+std::thread signal_rank_later(const std::string& marker, int rank, int signal, double after) {
+    return std::thread([=] {
+        auto start = std::chrono::steady_clock::now();
+        while (std::chrono::steady_clock::now() - start < std::chrono::seconds(30)) {
+            for (auto [r, pid] : ranks_with_marker(marker))
+                if (r == rank) {
+                    std::this_thread::sleep_for(std::chrono::duration<double>(after));
+                    kill(pid, signal);
+                    return;
+                }
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+    });
+}
+
+}  // namespace
+
+TEST_CASE("MPI messages: inputs, hellos, items and results read back as written", "[mpi]") {
+    FileBundle files = {{"a/scene.gltf", {'{', '}'}}, {"a/b.bin", {0, 1, 2, 255}}, {"empty", {}}};
+    FileBundle files_back;
+    std::string source_back;
+    wire::decode_inputs(wire::encode_inputs(files, "float3 estimate"), files_back, source_back);
+    CHECK(files_back == files);
+    CHECK(source_back == "float3 estimate");
+
+    wire::Hello hello{"node7", {{0, "pthread-cpu"}, {3, "gpu"}}, {"a warning"}};
+    wire::Hello hello_back = wire::decode_hello(wire::encode_hello(hello));
+    CHECK(hello_back.host == "node7");
+    CHECK(hello_back.devices == hello.devices);
+    CHECK(hello_back.warnings == hello.warnings);
+
+    WorkItem item{42, 3, 4, 100, 164};
+    wire::Bytes item_bytes = wire::encode_item(item);
+    CHECK(item_bytes.size() == 40);
+    std::optional<WorkItem> item_back = wire::decode_item(item_bytes);
+    REQUIRE(item_back);
+    CHECK(item_back->seq == 42);
+    CHECK(item_back->chunk_begin == 3);
+    CHECK(item_back->chunk_end == 4);
+    CHECK(item_back->pixel_begin == 100);
+    CHECK(item_back->pixel_end == 164);
+    CHECK_FALSE(wire::decode_item(wire::encode_item(std::nullopt)));
+
+    wire::ResultMessage m;
+    m.target_samples = 5000;
+    m.samples = 64 * 16;
+    m.seconds_busy = 0.25;
+    m.seconds_run = 0.5;
+    m.result.item = item;
+    for (int k = 0; k < 64; ++k) {
+        m.result.sums.push_back({float(k), 1.5f, -2.0f, 0.0f});
+        m.result.sums_sq.push_back({float(k * k), 2.25f, 4.0f, 7.0f});
+    }
+    wire::Bytes result_bytes = wire::encode_result(m);
+    CHECK(result_bytes.size() == 72 + 64 * 32);
+    wire::ResultMessage back = wire::decode_result(result_bytes, item);
+    CHECK_FALSE(back.failed);
+    CHECK(back.target_samples == 5000);
+    CHECK(back.samples == 1024);
+    CHECK(back.seconds_run == 0.5);
+    CHECK(std::memcmp(back.result.sums.data(), m.result.sums.data(), 64 * 16) == 0);
+    CHECK(std::memcmp(back.result.sums_sq.data(), m.result.sums_sq.data(), 64 * 16) == 0);
+    // The result of another item, a cut message, a failure.
+    WorkItem other = item;
+    other.seq = 43;
+    CHECK_THROWS_AS(wire::decode_result(result_bytes, other), RuntimeError);
+    result_bytes.pop_back();
+    CHECK_THROWS_AS(wire::decode_result(result_bytes, item), RuntimeError);
+    wire::ResultMessage failure;
+    failure.failed = true;
+    failure.error = "CL_OUT_OF_RESOURCES";
+    wire::ResultMessage failure_back = wire::decode_result(wire::encode_result(failure), item);
+    CHECK(failure_back.failed);
+    CHECK(failure_back.error == "CL_OUT_OF_RESOURCES");
+}
+
+TEST_CASE("the scene loaded from a bundle of the files rank 0 read is the same scene", "[mpi]") {
+    FileBundle files;
+    Scene a = load_gltf(kCornell, {}, nullptr, &files);
+    REQUIRE(files.size() == 2);  // the .gltf and its .bin
+    Scene b = load_gltf_from_bundle(kCornell, files, {});
+    CHECK(a.triangle_count() == b.triangle_count());
+    REQUIRE(a.positions.size() == b.positions.size());
+    CHECK(std::memcmp(a.positions.data(), b.positions.data(),
+                      a.positions.size() * sizeof(a.positions[0])) == 0);
+    files.erase(std::prev(files.end()));  // one file missing: an InputError, nothing read from disk
+    CHECK_THROWS_AS(load_gltf_from_bundle(kCornell, files, {}), InputError);
+}
+
+TEST_CASE("mpirun -n 3 renders the image of one process, bit for bit, every rank working",
+          "[mpi][cli]") {
+    const std::string launcher = mpirun();
+    TempDir dir;
+    ProcessResult one = run_process(MCRT_EXE, render_args(dir / "one.exr"), dir.path());
+    REQUIRE(one.exit_code == 0);
+    ProcessResult three =
+        run_mpi(3, render_args(dir / "three.exr", {"--stats", dir / "three.json"}), dir);
+    INFO("stderr: " << three.err);
+    REQUIRE(three.exit_code == 0);
+    CHECK(three.err.empty());  // --quiet: no rank prints anything
+    Image a = read_exr(dir / "one.exr"), b = read_exr(dir / "three.exr");
+    CHECK(same_bits(a.rgb, b.rgb));
+    CHECK(same_bits(a.variance, b.variance));
+    nlohmann::json stats = nlohmann::json::parse(read_whole_file(dir / "three.json"));
+    REQUIRE(stats["ranks"].size() == 3);
+    uint64_t samples = 0;
+    for (const auto& r : stats["ranks"]) {
+        INFO(r.dump());
+        CHECK(r["samples"].get<uint64_t>() > 0);
+        CHECK(r["items"].get<uint64_t>() > 0);
+        CHECK(r["devices"] == 1);
+        CHECK(r.contains("host"));
+        CHECK(r.contains("seconds_busy"));
+        samples += r["samples"].get<uint64_t>();
+    }
+    CHECK(samples == 48u * 40u * 64u);
+    CHECK(stats["ranks"][1]["message_bytes"].get<uint64_t>() > 0);
+}
+
+TEST_CASE("two ranks of two devices each render the image of one process", "[mpi][cli]") {
+    mpirun();
+    TempDir dir;
+    ProcessResult one = run_process(MCRT_EXE, render_args(dir / "one.exr"), dir.path());
+    REQUIRE(one.exit_code == 0);
+    setenv("POCL_DEVICES", "pthread basic", 1);
+    ProcessResult two = run_mpi(
+        2, render_args(dir / "two.exr", {"--device", "all", "--stats", dir / "two.json"}), dir);
+    unsetenv("POCL_DEVICES");
+    INFO("stderr: " << two.err);
+    REQUIRE(two.exit_code == 0);
+    CHECK(same_bits(read_exr(dir / "one.exr").rgb, read_exr(dir / "two.exr").rgb));
+    nlohmann::json stats = nlohmann::json::parse(read_whole_file(dir / "two.json"));
+    REQUIRE(stats["ranks"].size() == 2);
+    CHECK(stats["ranks"][0]["devices"] == 2);
+    CHECK(stats["ranks"][1]["devices"] == 2);
+    CHECK(stats["devices"].size() == 4);
+}
+
+TEST_CASE("a device fault on one rank retires it and leaves the image unchanged", "[mpi][cli]") {
+    const std::string launcher = mpirun();
+    TempDir dir;
+    ProcessResult one = run_process(MCRT_EXE, render_args(dir / "one.exr"), dir.path());
+    REQUIRE(one.exit_code == 0);
+    // MPMD: rank 1 alone has the fault switch (its device 0 fails at its first launch).
+    std::vector<std::string> a = {"--oversubscribe", "-n", "1", MCRT_EXE};
+    std::vector<std::string> r = render_args(dir / "faulty.exr", {"--stats", dir / "f.json"});
+    a.insert(a.end(), r.begin(), r.end());
+    a.insert(a.end(), {":", "-n", "1", "env", "MCRT_FAULT_INJECT=0:1", MCRT_EXE});
+    a.insert(a.end(), r.begin(), r.end());
+    ProcessResult faulty = run_process(launcher, a, dir.path(), 60);
+    INFO("stderr: " << faulty.err);
+    REQUIRE(faulty.exit_code == 0);
+    std::vector<std::string> warnings = lines_starting_with(faulty.err, "mcrt: warning:");
+    REQUIRE(warnings.size() == 1);
+    CHECK(warnings[0].find("rank 1 device 0") != std::string::npos);
+    CHECK(warnings[0].find("retired") != std::string::npos);
+    CHECK(warnings[0].find("CL_OUT_OF_RESOURCES") != std::string::npos);
+    CHECK(same_bits(read_exr(dir / "one.exr").rgb, read_exr(dir / "faulty.exr").rgb));
+    nlohmann::json stats = nlohmann::json::parse(read_whole_file(dir / "f.json"));
+    CHECK(stats["ranks"][1]["devices_retired"] == 1);
+    CHECK(stats["ranks"][1]["samples"] == 0);
+    CHECK(stats["ranks"][0]["samples"] == 48 * 40 * 64);
+}
+
+TEST_CASE("bad input under mpirun: every rank exits 2, with one error line", "[mpi][cli]") {
+    mpirun();
+    TempDir dir;
+    struct Case {
+        const char* what;
+        std::vector<std::string> args;
+    };
+    std::vector<Case> cases = {
+        {"missing scene", {"render", dir / "none.gltf", "--out", dir / "x.exr"}},
+        {"unknown option", {"render", kCornell, "--out", dir / "x.exr", "--no-such-option"}},
+        {"bad camera", {"render", kCornell, "--out", dir / "x.exr", "--camera", "9"}},
+        {"estimator that does not build",
+         {"render", kCornell, "--out", dir / "x.exr", "--width", "8", "--height", "8",
+          "--estimator-file", dir / "bad.cl"}},
+    };
+    {
+        std::ofstream bad(dir / "bad.cl");
+        bad << "float3 estimate(this is not C\n";
+    }
+    for (const Case& c : cases) {
+        ProcessResult r = run_mpi(2, c.args, dir, 60);
+        INFO(c.what << "; stderr: " << r.err);
+        CHECK(!r.timed_out);
+        CHECK(r.exit_code == 2);
+        CHECK(lines_starting_with(r.err, "mcrt: error:").size() == 1);
+        CHECK(!std::filesystem::exists(dir / "x.exr"));
+    }
+}
+
+TEST_CASE("under mpirun a time limit or SIGINT to rank 0 stops every rank and writes the "
+          "whole chunks done",
+          "[mpi][cli]") {
+    mpirun();
+    TempDir dir;
+    for (int how : {0, 1}) {
+        const std::string exr = dir / ("partial" + std::to_string(how) + ".exr");
+        std::vector<std::string> args = {"render", kCornell, "--width", "64", "--height", "64",
+                                         "--spp", "1000000", "--quiet", "--out", exr, "--stats",
+                                         dir / "partial.json"};
+        const std::string marker = dir.path().string() + std::to_string(how);
+        setenv("MCRT_TEST_MPI_MARKER", marker.c_str(), 1);
+        std::thread signaller;
+        if (how == 0)
+            args.insert(args.end(), {"--time-limit", "2"});
+        else
+            signaller = signal_rank_later(marker, 0, SIGINT, 3.0);
+        ProcessResult r = run_mpi(2, args, dir, 60);
+        if (signaller.joinable()) signaller.join();
+        unsetenv("MCRT_TEST_MPI_MARKER");
+        INFO((how == 0 ? "time limit" : "SIGINT") << "; stderr: " << r.err);
+        REQUIRE(r.exit_code == 0);
+        CHECK(r.seconds < 30);
+        Image img = read_exr(exr);
+        nlohmann::json stats = nlohmann::json::parse(read_whole_file(dir / "partial.json"));
+        const uint32_t spp = stats["spp"].get<uint32_t>();
+        CHECK(stats["stopped_by"] == (how == 0 ? "time limit" : "interrupt"));
+        CHECK(spp > 0);
+        CHECK(spp % 16 == 0);
+        CHECK(img.spp == spp);
+        CHECK(stats["ranks"][1]["samples"].get<uint64_t>() > 0);
+        // Exactly the render of spp samples by one process.
+        ProcessResult again = run_process(
+            MCRT_EXE, {"render", kCornell, "--width", "64", "--height", "64", "--spp",
+                       std::to_string(spp), "--quiet", "--out", dir / "full.exr"},
+            dir.path(), 120);
+        REQUIRE(again.exit_code == 0);
+        CHECK(same_bits(img.rgb, read_exr(dir / "full.exr").rgb));
+    }
+}
+
+TEST_CASE("a rank killed mid-render ends the job: mpirun exits non-zero, nothing is written",
+          "[mpi][cli]") {
+    // MPI's own semantics (docs/MPI.md "When a rank dies"): OpenMPI's mpirun sees the process
+    // die and ends the job, rank 0 included, before rank 0 can notice through MPI.
+    mpirun();
+    TempDir dir;
+    const std::string marker = dir.path().string() + "kill";
+    setenv("MCRT_TEST_MPI_MARKER", marker.c_str(), 1);
+    std::thread killer = signal_rank_later(marker, 1, SIGKILL, 3.0);
+    ProcessResult r = run_mpi(2,
+                              {"render", kCornell, "--width", "64", "--height", "64", "--spp",
+                               "1000000", "--quiet", "--out", dir / "killed.exr"},
+                              dir, 60);
+    killer.join();
+    unsetenv("MCRT_TEST_MPI_MARKER");
+    INFO("stderr: " << r.err);
+    CHECK(!r.timed_out);
+    CHECK(r.exit_code != 0);
+    CHECK(!std::filesystem::exists(dir / "killed.exr"));
+}
