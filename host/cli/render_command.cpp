@@ -282,8 +282,11 @@ int run_render(const RenderOptions& o) {
         const int status = render_here(o, &job);
         job.finish(status);
         return status;
-    } catch (const InputError&) {
-        job.finish(2);
+    } catch (const InputError& e) {
+        job.finish(2, e.what());
+        throw;
+    } catch (const std::exception& e) {
+        job.finish(1, e.what());
         throw;
     } catch (...) {
         job.finish(1);

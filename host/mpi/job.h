@@ -49,7 +49,9 @@ class RenderJob {
     nlohmann::json ranks_json(const std::vector<DeviceReport>& devices) const;
 
     // The command's exit status, to every rank (they exit with it); then the job is over.
-    void finish(int status);
+    // `error` is the command's error line, printed here only when a lost rank forces MPI_Abort.
+    // With a rank lost, ends the process with MPI_Abort: status 3 when the outputs were written.
+    void finish(int status, const std::string& error = "");
 
   private:
     struct State;

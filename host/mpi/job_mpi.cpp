@@ -79,7 +79,17 @@ struct RenderJob::State {
     void receive_hellos(const std::function<void(const std::string&)>& warn,
                         std::vector<std::unique_ptr<RenderWorker>>& workers) {
         for (int r = 1; r < g_size; ++r) {
-            const wire::Hello hello = wire::decode_hello(mpi::receive_bytes(r, mpi::kHelloTag));
+            std::optional<wire::Bytes> bytes =
+                mpi::receive_bytes_within(r, mpi::kHelloTag, mpi::silence_timeout());
+            if (!bytes) {
+                traffic[size_t(r)].lost = true;
+                if (warn)
+                    warn("rank " + std::to_string(r) + " sent no hello within " +
+                         std::to_string(int(mpi::silence_timeout())) +
+                         " s and is taken for dead; rendering without it");
+                continue;
+            }
+            const wire::Hello hello = wire::decode_hello(*bytes);
             hosts[size_t(r)] = hello.host;
             devices_set_up[size_t(r)] = int(hello.devices.size());
             const std::string who = "rank " + std::to_string(r) + " (" + hello.host + ")";
@@ -153,10 +163,19 @@ nlohmann::json RenderJob::ranks_json(const std::vector<DeviceReport>& devices) c
     return ranks;
 }
 
-void RenderJob::finish(int status) {
+void RenderJob::finish(int status, const std::string& error) {
     State& s = *state_;
     if (s.finished) return;
     s.finished = true;
+    for (int r = 1; r < g_size; ++r)
+        if (s.traffic[size_t(r)].lost) {
+            // A dead rank takes no part in a collective: rank 0 has written what it could, and
+            // ends the job (every rank, and mpirun's status) the only way MPI leaves.
+            if (!error.empty()) std::fprintf(stderr, "mcrt: error: %s\n", error.c_str());
+            std::fprintf(stderr, "mcrt: warning: rank %d was lost; ending the job with MPI_Abort\n", r);
+            std::fflush(stderr);
+            MPI_Abort(MPI_COMM_WORLD, status == 0 ? 3 : status);
+        }
     if (!s.inputs_sent) {
         mpi::broadcast_u64(uint64_t(status == 0 ? 1 : status), 0);  // stop before any work
         return;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <limits>
 #include <string>
 #include <thread>
@@ -28,9 +29,10 @@ void send_bytes(const wire::Bytes& bytes, int dest, int tag) {
           "MPI_Send");
 }
 
-wire::Bytes receive_bytes(int source, int tag) {
+std::optional<wire::Bytes> receive_bytes_within(int source, int tag, double seconds) {
     // 20 µs doubling to 1 ms: a reply within a fraction of a millisecond of its arrival, next to
     // items of about 150 ms.
+    const auto start = std::chrono::steady_clock::now();
     auto pause = std::chrono::microseconds(20);
     MPI_Message message;
     MPI_Status status;
@@ -38,6 +40,9 @@ wire::Bytes receive_bytes(int source, int tag) {
         int found = 0;
         check(MPI_Improbe(source, tag, MPI_COMM_WORLD, &found, &message, &status), "MPI_Improbe");
         if (found) break;
+        if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >
+            seconds)
+            return std::nullopt;
         std::this_thread::sleep_for(pause);
         pause = std::min(pause * 2, decltype(pause)(1000));
     }
@@ -46,6 +51,16 @@ wire::Bytes receive_bytes(int source, int tag) {
     wire::Bytes bytes(size_t(std::max(count, 0)));
     check(MPI_Mrecv(bytes.data(), count, MPI_BYTE, &message, MPI_STATUS_IGNORE), "MPI_Mrecv");
     return bytes;
+}
+
+wire::Bytes receive_bytes(int source, int tag) {
+    return *receive_bytes_within(source, tag, std::numeric_limits<double>::infinity());
+}
+
+double silence_timeout() {
+    const char* text = std::getenv("MCRT_MPI_TIMEOUT");
+    const double seconds = text ? std::atof(text) : 0.0;
+    return seconds > 0 ? seconds : 120.0;
 }
 
 uint64_t broadcast_u64(uint64_t value, int root) {

@@ -12,6 +12,7 @@ namespace mcrt {
 struct RankTraffic {
     uint64_t bytes = 0;            // items sent and results received
     double seconds_overhead = 0;   // per item: round trip minus the item's wall time there
+    bool lost = false;             // fell silent (mpi::silence_timeout()): taken for dead
 };
 
 class RemoteWorker : public RenderWorker {
@@ -24,7 +25,8 @@ class RemoteWorker : public RenderWorker {
 
     uint64_t target_samples() const override { return target_; }
     // Sends the item and waits for its result; a device that failed there throws RuntimeError
-    // with its error, and the scheduler retires it.
+    // with its error, and the scheduler retires it; so does a rank silent for longer than
+    // mpi::silence_timeout() (and the whole rank is lost: it is not told to stop).
     BatchResult run(const WorkItem& item) override;
     void commit_report() override;
 
@@ -35,6 +37,7 @@ class RemoteWorker : public RenderWorker {
     uint64_t target_ = 1024;
     uint64_t pending_samples_ = 0, pending_bytes_ = 0;
     double pending_busy_ = 0, pending_overhead_ = 0;
+    double last_run_ = 0;  // the last item's wall time on that rank
 };
 
 }  // namespace mcrt
