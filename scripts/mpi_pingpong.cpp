@@ -30,7 +30,8 @@ int main(int argc, char** argv) {
             mpi::send_bytes(wire::encode_item(item), 1, mpi::item_tag(0));
             wire::Bytes reply = mpi::receive_bytes(1, mpi::result_tag(0));
             wire::ResultMessage m = wire::decode_result(reply, item);
-            total += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            total +=
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             bytes = reply.size() + 40;
         }
         mpi::send_bytes(wire::encode_item(std::nullopt), 1, mpi::item_tag(0));

@@ -3,16 +3,14 @@
 // fault on one rank must behave as they do on one machine, bad input must end every rank with
 // one error line, and the death of a rank must end the job rather than hang it. Skipped when mcrt
 // was built without MPI or mpirun is not installed; the message format is tested in every build.
-#include <catch2/catch.hpp>
-
 #include <dirent.h>
 
+#include <catch2/catch.hpp>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
-#include <thread>
-
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "common/error.h"
 #include "image/image.h"
@@ -61,8 +59,8 @@ bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
 }
 
 std::vector<std::string> render_args(const std::string& out, std::vector<std::string> extra = {}) {
-    std::vector<std::string> a = {"render", kCornell, "--width", "48", "--height", "40",
-                                  "--spp", "64", "--quiet", "--out", out};
+    std::vector<std::string> a = {"render", kCornell, "--width", "48",    "--height", "40",
+                                  "--spp",  "64",     "--quiet", "--out", out};
     a.insert(a.end(), extra.begin(), extra.end());
     return a;
 }
@@ -290,16 +288,18 @@ TEST_CASE("bad input under mpirun: every rank exits 2, with one error line", "[m
     }
 }
 
-TEST_CASE("under mpirun a time limit or SIGINT to rank 0 stops every rank and writes the "
-          "whole chunks done",
-          "[mpi][cli]") {
+TEST_CASE(
+    "under mpirun a time limit or SIGINT to rank 0 stops every rank and writes the "
+    "whole chunks done",
+    "[mpi][cli]") {
     mpirun();
     TempDir dir;
     for (int how : {0, 1}) {
         const std::string exr = dir / ("partial" + std::to_string(how) + ".exr");
-        std::vector<std::string> args = {"render", kCornell, "--width", "64", "--height", "64",
-                                         "--spp", "1000000", "--quiet", "--out", exr, "--stats",
-                                         dir / "partial.json"};
+        std::vector<std::string> args = {
+            "render", kCornell,  "--width",           "64",      "--height",
+            "64",     "--spp",   "1000000",           "--quiet", "--out",
+            exr,      "--stats", dir / "partial.json"};
         const std::string marker = dir.path().string() + std::to_string(how);
         setenv("MCRT_TEST_MPI_MARKER", marker.c_str(), 1);
         std::thread signaller;
@@ -322,10 +322,11 @@ TEST_CASE("under mpirun a time limit or SIGINT to rank 0 stops every rank and wr
         CHECK(img.spp == spp);
         CHECK(stats["ranks"][1]["samples"].get<uint64_t>() > 0);
         // Exactly the render of spp samples by one process.
-        ProcessResult again = run_process(
-            MCRT_EXE, {"render", kCornell, "--width", "64", "--height", "64", "--spp",
-                       std::to_string(spp), "--quiet", "--out", dir / "full.exr"},
-            dir.path(), 120);
+        ProcessResult again =
+            run_process(MCRT_EXE,
+                        {"render", kCornell, "--width", "64", "--height", "64", "--spp",
+                         std::to_string(spp), "--quiet", "--out", dir / "full.exr"},
+                        dir.path(), 120);
         REQUIRE(again.exit_code == 0);
         CHECK(same_bits(img.rgb, read_exr(dir / "full.exr").rgb));
     }
@@ -352,21 +353,38 @@ TEST_CASE("a rank killed mid-render ends the job: mpirun exits non-zero, nothing
     CHECK(!std::filesystem::exists(dir / "killed.exr"));
 }
 
-TEST_CASE("with mpirun --enable-recovery rank 0 outlives a killed rank, redoes its work and "
-          "writes the image",
-          "[mpi][cli]") {
+TEST_CASE(
+    "with mpirun --enable-recovery rank 0 outlives a killed rank, redoes its work and "
+    "writes the image",
+    "[mpi][cli]") {
     const std::string launcher = mpirun();
     TempDir dir;
     const std::string marker = dir.path().string() + "recover";
     setenv("MCRT_TEST_MPI_MARKER", marker.c_str(), 1);
     setenv("MCRT_MPI_TIMEOUT", "2", 1);
     std::thread killer = signal_rank_later(marker, 1, SIGKILL, 2.0);
-    ProcessResult r = run_process(
-        launcher,
-        {"--enable-recovery", "--oversubscribe", "-n", "2", MCRT_EXE, "render", kCornell,
-         "--width", "64", "--height", "64", "--spp", "1000000", "--quiet", "--time-limit", "6",
-         "--out", dir / "recovered.exr", "--stats", dir / "recovered.json"},
-        dir.path(), 60);
+    ProcessResult r = run_process(launcher,
+                                  {"--enable-recovery",
+                                   "--oversubscribe",
+                                   "-n",
+                                   "2",
+                                   MCRT_EXE,
+                                   "render",
+                                   kCornell,
+                                   "--width",
+                                   "64",
+                                   "--height",
+                                   "64",
+                                   "--spp",
+                                   "1000000",
+                                   "--quiet",
+                                   "--time-limit",
+                                   "6",
+                                   "--out",
+                                   dir / "recovered.exr",
+                                   "--stats",
+                                   dir / "recovered.json"},
+                                  dir.path(), 60);
     killer.join();
     unsetenv("MCRT_TEST_MPI_MARKER");
     unsetenv("MCRT_MPI_TIMEOUT");
@@ -381,10 +399,11 @@ TEST_CASE("with mpirun --enable-recovery rank 0 outlives a killed rank, redoes i
     CHECK(stats["stopped_by"] == "time limit");
     CHECK(stats["ranks"][1]["devices_retired"] == 1);
     REQUIRE(spp > 0);
-    ProcessResult again = run_process(
-        MCRT_EXE, {"render", kCornell, "--width", "64", "--height", "64", "--spp",
-                   std::to_string(spp), "--quiet", "--out", dir / "full.exr"},
-        dir.path(), 120);
+    ProcessResult again =
+        run_process(MCRT_EXE,
+                    {"render", kCornell, "--width", "64", "--height", "64", "--spp",
+                     std::to_string(spp), "--quiet", "--out", dir / "full.exr"},
+                    dir.path(), 120);
     REQUIRE(again.exit_code == 0);
     CHECK(same_bits(read_exr(dir / "recovered.exr").rgb, read_exr(dir / "full.exr").rgb));
 }

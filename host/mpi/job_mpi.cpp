@@ -51,8 +51,9 @@ JobSession::JobSession() {
     // Every rank's device threads send and receive at once.
     if (g_size > 1 && provided < MPI_THREAD_MULTIPLE) {
         if (g_rank == 0)
-            std::fprintf(stderr, "mcrt: error: the MPI library does not support "
-                                 "MPI_THREAD_MULTIPLE, which a render across ranks needs\n");
+            std::fprintf(stderr,
+                         "mcrt: error: the MPI library does not support "
+                         "MPI_THREAD_MULTIPLE, which a render across ranks needs\n");
         MPI_Finalize();
         std::exit(1);
     }
@@ -72,7 +73,6 @@ int job_size() { return g_size; }
 struct RenderJob::State {
     bool inputs_sent = false, hellos_received = false, finished = false;
     std::vector<std::string> hosts;
-    std::vector<int> devices_set_up;
     std::vector<RankTraffic> traffic;  // per rank; RemoteWorkers count into it
 
     // Every other rank's hello; the workers for their devices go to `workers`.
@@ -91,7 +91,6 @@ struct RenderJob::State {
             }
             const wire::Hello hello = wire::decode_hello(*bytes);
             hosts[size_t(r)] = hello.host;
-            devices_set_up[size_t(r)] = int(hello.devices.size());
             const std::string who = "rank " + std::to_string(r) + " (" + hello.host + ")";
             for (const std::string& w : hello.warnings)
                 if (warn) warn(who + ": " + w);
@@ -109,7 +108,6 @@ struct RenderJob::State {
 RenderJob::RenderJob() : state_(std::make_unique<State>()) {
     state_->hosts.assign(size_t(g_size), "");
     state_->hosts[0] = mpi::host_name();
-    state_->devices_set_up.assign(size_t(g_size), 0);
     state_->traffic.resize(size_t(g_size));
 }
 
@@ -172,7 +170,8 @@ void RenderJob::finish(int status, const std::string& error) {
             // A dead rank takes no part in a collective: rank 0 has written what it could, and
             // ends the job (every rank, and mpirun's status) the only way MPI leaves.
             if (!error.empty()) std::fprintf(stderr, "mcrt: error: %s\n", error.c_str());
-            std::fprintf(stderr, "mcrt: warning: rank %d was lost; ending the job with MPI_Abort\n", r);
+            std::fprintf(stderr, "mcrt: warning: rank %d was lost; ending the job with MPI_Abort\n",
+                         r);
             std::fflush(stderr);
             MPI_Abort(MPI_COMM_WORLD, status == 0 ? 3 : status);
         }
@@ -268,8 +267,8 @@ int serve_render(const RenderOptions& o) {
                 workers.push_back(std::make_unique<DeviceWorker>(*contexts.back(), gpu_scene,
                                                                  settings, fixed_batch));
             } catch (const std::exception& e) {
-                warn("skipping device " + std::to_string(d.index) + " ('" + d.name + "'): " +
-                     e.what());
+                warn("skipping device " + std::to_string(d.index) + " ('" + d.name +
+                     "'): " + e.what());
             }
         }
     } catch (const std::exception& e) {

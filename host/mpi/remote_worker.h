@@ -10,9 +10,9 @@ namespace mcrt {
 
 // What rank 0 measured of its messages with one rank, for the stats and docs/BENCHMARKS.md.
 struct RankTraffic {
-    uint64_t bytes = 0;            // items sent and results received
-    double seconds_overhead = 0;   // per item: round trip minus the item's wall time there
-    bool lost = false;             // fell silent (mpi::silence_timeout()): taken for dead
+    uint64_t bytes = 0;           // items sent and results received
+    double seconds_overhead = 0;  // per item: round trip minus the item's wall time there
+    bool lost = false;            // fell silent (mpi::silence_timeout()): taken for dead
 };
 
 class RemoteWorker : public RenderWorker {

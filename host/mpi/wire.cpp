@@ -164,7 +164,8 @@ Bytes encode_item(const std::optional<WorkItem>& item) {
 std::optional<WorkItem> decode_item(const Bytes& bytes) {
     Reader r(bytes);
     const uint64_t kind = r.u64();
-    if (kind != kItem && kind != kStop) throw RuntimeError("MPI: a message that is not a work item");
+    if (kind != kItem && kind != kStop)
+        throw RuntimeError("MPI: a message that is not a work item");
     WorkItem item = read_item(r);
     r.done();
     if (kind == kStop) return std::nullopt;

@@ -41,12 +41,12 @@ std::optional<WorkItem> decode_item(const Bytes& bytes);
 // float4 sums per 16 samples: 2 bytes per sample).
 struct ResultMessage {
     bool failed = false;
-    std::string error;             // when failed
-    uint64_t target_samples = 0;   // what the device's next item should hold
-    uint64_t samples = 0;          // samples of this item
-    double seconds_busy = 0;       // its kernel time
-    double seconds_run = 0;        // the item's wall time on that rank (kernels and read-back)
-    BatchResult result;            // result.item is the item sent
+    std::string error;            // when failed
+    uint64_t target_samples = 0;  // what the device's next item should hold
+    uint64_t samples = 0;         // samples of this item
+    double seconds_busy = 0;      // its kernel time
+    double seconds_run = 0;       // the item's wall time on that rank (kernels and read-back)
+    BatchResult result;           // result.item is the item sent
 };
 Bytes encode_result(const ResultMessage& message);
 // Checks that the sums are those of `item` (the item this device was sent).
