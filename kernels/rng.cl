@@ -34,8 +34,10 @@ typedef struct {
 /* Dimensions of the stream, shared by every estimator (a user's too) so that two estimators
  * are compared on the same samples (common random numbers). A 2D dimension d uses d and d + 1. */
 #define DIM_PIXEL_JITTER 0u   /* 2D */
-#define DIM_LIGHT_SELECT 2u   /* 1D */
-#define DIM_LIGHT_POINT 3u    /* 2D: point on the light, or direction in its spherical triangle */
+#define DIM_LIGHT_FINE 2u     /* 1D: refines DIM_LIGHT's x below the light selection's grid */
+#define DIM_LIGHT 3u          /* 2D: x chooses the light and, remapped, with y the point on it
+                                 (or the direction in its spherical triangle): one stratified
+                                 sample for both (discrete.cl) */
 #define DIM_DIRECTION 5u      /* 2D: hemisphere or BSDF direction (hemisphere, MIS, ambient) */
 #define DIM_PIXEL_ROTATION 7u /* 2D, per pixel: rotation of the Fibonacci spiral */
 /* Dimensions DIM_USER, DIM_USER + 1, ... belong to users' estimators: no built-in code uses
