@@ -37,6 +37,11 @@ class DeviceWorker {
     // Adds the last successful launch to the report; the caller holds the render's lock.
     void commit_report();
 
+private:
+    // Makes the sums buffer hold `runs` ChunkSums, reallocating when it is smaller.
+    void reserve_sums(uint64_t runs);
+
+public:
     DeviceReport report;
 
   private:
@@ -50,7 +55,8 @@ class DeviceWorker {
     uint64_t pending_samples_ = 0;
     cl::Kernel render_, reduce_;
     std::unique_ptr<GpuSceneBuffers> buffers_;
-    cl::Buffer samples_, sums_, sums_sq_;
+    cl::Buffer samples_, sums_;
+    uint64_t sums_capacity_ = 0;  // ChunkSums the sums_ buffer holds
 };
 
 }  // namespace mcrt
