@@ -496,9 +496,9 @@ TEST_CASE("the EXR and the stats say which variance estimate the layer holds", "
          {std::make_tuple("independent", "1", "16"), std::make_tuple("sobol", "4", "16"),
           std::make_tuple("sobol", "2", "6"), std::make_tuple("stratified", "1", "1")}) {
         Sandbox box;
-        ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("x.exr"), "--stats",
-                                          box.out("x.json"), "--sampler", sampler, "--spp", spp,
-                                          "--width", "16", "--height", "16", "--quiet"}));
+        ProcessResult r = box.run({"render", kCornell, "--out", box.out("x.exr"), "--stats",
+                                   box.out("x.json"), "--sampler", sampler, "--spp", spp, "--width",
+                                   "16", "--height", "16", "--quiet"});
         INFO(sampler << ", spp " << spp << ": " << r.err);
         REQUIRE(r.exit_code == 0);
         std::ifstream in(box.out("x.json"));
