@@ -65,7 +65,7 @@ constexpr const char* kUserEstimatorFunction = "estimate";
 // Replicates the variance layer is estimated from when the sampler (or the estimator) correlates
 // a pixel's samples and --replicates is not given: the trade-off between the error bar's own
 // noise and the QMC efficiency that splitting loses is measured in docs/EXPERIMENTS.md.
-constexpr unsigned kDefaultReplicates = 4;
+constexpr unsigned kDefaultReplicates = 2;
 
 // Every table as JSON text (`mcrt variants --json`).
 std::string variants_json();
