@@ -18,8 +18,8 @@
  * solid angle through cosθ_y / d² (PBRT 3rd ed. 14.2.2; Veach 1997 eq. 8.4). */
 inline float3 estimate_light_area(const SceneView* scene, const SurfacePoint* sp,
                                   const SampleStream* stream, uint* rays) {
-    LightSample ls = sample_light_area(scene, sp, sample_1d(stream, DIM_LIGHT_SELECT),
-                                       sample_2d(stream, DIM_LIGHT_POINT));
+    LightSample ls = sample_light_area(scene, sp, sample_2d(stream, DIM_LIGHT),
+                                       sample_1d(stream, DIM_LIGHT_FINE));
     float cos_x = dot(sp->n, ls.wi);
     if (!ls.valid || cos_x <= 0.0f) return (float3)(0.0f); /* behind the receiver */
     *rays += 1u;
@@ -32,8 +32,8 @@ inline float3 estimate_light_area(const SceneView* scene, const SurfacePoint* sp
 /* Directions uniform in the spherical triangle the chosen light subtends (Arvo 1995). */
 inline float3 estimate_light_solid_angle(const SceneView* scene, const SurfacePoint* sp,
                                          const SampleStream* stream, uint* rays) {
-    LightSample ls = sample_light_solid_angle(scene, sp, sample_1d(stream, DIM_LIGHT_SELECT),
-                                              sample_2d(stream, DIM_LIGHT_POINT));
+    LightSample ls = sample_light_solid_angle(scene, sp, sample_2d(stream, DIM_LIGHT),
+                                              sample_1d(stream, DIM_LIGHT_FINE));
     float cos_x = dot(sp->n, ls.wi);
     if (!ls.valid || cos_x <= 0.0f) return (float3)(0.0f);
     *rays += 1u;
@@ -78,8 +78,8 @@ inline float3 estimate_mis(const SceneView* scene, const SurfacePoint* sp,
     float3 L = (float3)(0.0f);
 
     /* Light strategy. */
-    LightSample ls = sample_light_area(scene, sp, sample_1d(stream, DIM_LIGHT_SELECT),
-                                       sample_2d(stream, DIM_LIGHT_POINT));
+    LightSample ls = sample_light_area(scene, sp, sample_2d(stream, DIM_LIGHT),
+                                       sample_1d(stream, DIM_LIGHT_FINE));
     float cos_x = dot(sp->n, ls.wi);
     if (ls.valid && cos_x > 0.0f) {
         *rays += 1u;

@@ -56,13 +56,13 @@ inline float light_area_pdf_w(float pmf, float pdf_a, float d2, float cos_light)
 
 /* ---- Area strategy: (light, point) with density pmf(light)/area ------------------------------ */
 
-inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint* sp, float u_select,
-                                     float2 u_point) {
+inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint* sp, float2 u,
+                                     float u_fine) {
     LightSample ls = no_light_sample();
     if (scene->lights.light_count == 0u) return ls;
-    DiscreteSample choice = select_light(&scene->lights, u_select);
+    DiscreteSample choice = select_light(&scene->lights, u.x, u_fine);
     Light light = scene->lights.lights[choice.index];
-    LightPoint lp = sample_light_point(&light, u_point);
+    LightPoint lp = sample_light_point(&light, (float2)(choice.u_remap, u.y));
     float3 to_light = lp.p - sp->p;
     float d2 = dot(to_light, to_light);
     if (!(d2 > 0.0f)) return ls;
@@ -89,11 +89,12 @@ inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint*
 /* Density pmf(light)/Ω, no 1/d² left in the estimate. Tiny or huge solid angles fall back to
  * area sampling, a choice fixed by (point, light), so the estimator stays unbiased. */
 inline LightSample sample_light_solid_angle(const SceneView* scene, const SurfacePoint* sp,
-                                            float u_select, float2 u) {
+                                            float2 u_light, float u_fine) {
     LightSample ls = no_light_sample();
     if (scene->lights.light_count == 0u) return ls;
-    DiscreteSample choice = select_light(&scene->lights, u_select);
+    DiscreteSample choice = select_light(&scene->lights, u_light.x, u_fine);
     Light light = scene->lights.lights[choice.index];
+    float2 u = (float2)(choice.u_remap, u_light.y); /* the rest of the sample, for the direction */
     float3 n_light = light_normal(&light);
     float3 x = sp->p;
     /* A one-sided light seen from behind its plane shows only its back. */

@@ -14,18 +14,16 @@ typedef struct {
     uint light_count;
 } LightSet;
 
-/* Selects a light (-D LIGHT_SELECT_UNIFORM, LIGHT_SELECT_POWER or LIGHT_SELECT_ALIAS);
- * light_count must be > 0. */
-inline DiscreteSample select_light(const LightSet* ls, float u) {
+/* Selects a light from u (-D LIGHT_SELECT_UNIFORM, LIGHT_SELECT_POWER or LIGHT_SELECT_ALIAS),
+ * refined below the 2^-24 grid by u_fine (discrete.cl); the choice's u_remap is uniform again,
+ * for the point on the light. light_count must be > 0. */
+inline DiscreteSample select_light(const LightSet* ls, float u, float u_fine) {
 #if defined(LIGHT_SELECT_UNIFORM)
-    DiscreteSample c;
-    c.index = min((uint)(u * (float)ls->light_count), ls->light_count - 1u);
-    c.pmf = 1.0f / (float)ls->light_count;
-    return c;
+    return sample_discrete_uniform(ls->light_count, u, u_fine);
 #elif defined(LIGHT_SELECT_ALIAS)
-    return sample_discrete_alias(ls->alias, ls->light_count, u);
+    return sample_discrete_alias(ls->alias, ls->light_count, u, u_fine);
 #else
-    return sample_discrete_cdf(ls->light_cdf, ls->light_count, u);
+    return sample_discrete_cdf(ls->light_cdf, ls->light_count, u, u_fine);
 #endif
 }
 
@@ -52,7 +50,7 @@ inline float3 light_normal(const Light* light) {
 }
 
 typedef struct {
-    float3 p;  /* point on the light */
+    float3 p; /* point on the light */
     float pdf_a;
 } LightPoint;
 

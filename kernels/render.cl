@@ -41,8 +41,10 @@ kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* pa
 
     SampleStream stream;
     stream.pixel = pixel;
-    stream.sample = p.sample_begin + (uint)(g % p.batch_samples);
-    stream.sample_count = p.spp;
+    stream.index = p.sample_begin + (uint)(g % p.batch_samples);
+    stream.replicate = stream.index % p.replicates;
+    stream.sample = stream.index / p.replicates;
+    stream.sample_count = p.spp / p.replicates;
     stream.seed = p.seed;
 
     SceneView scene;
@@ -72,32 +74,53 @@ inline bool finite3(float3 v) {
 }
 
 /* Sums each pixel's samples of a batch in chunks of MCRT_SAMPLES_PER_CHUNK consecutive samples,
- * in sample order. Work-item g handles chunk g % chunks of pixel g / chunks, chunks =
- * ceil(batch_samples / MCRT_SAMPLES_PER_CHUNK); writes sums[g] = (ΣR, ΣG, ΣB, non-finite count)
- * and sums_sq[g] = (ΣR², ΣG², ΣB², rays traced). Non-finite samples are counted and left out. */
+ * in sample order, one run per replicate within each chunk (the chunk starts on a multiple of
+ * 16, which `replicates` divides: local sample k belongs to replicate k % replicates).
+ * Work-item g handles chunk g % chunks of pixel g / chunks, chunks =
+ * ceil(batch_samples / MCRT_SAMPLES_PER_CHUNK), and writes sums[g · replicates + r] for each
+ * replicate r (ChunkSums: shifted and scaled, so that nothing cancels or overflows). Non-finite
+ * samples are counted and read as 0. */
 kernel void reduce_chunks(global const float4* samples, uint batch_samples, uint pixel_count,
-                          global float4* sums, global float4* sums_sq) {
+                          uint replicates, global ChunkSums* sums) {
     size_t g = get_global_id(0);
     uint chunks = (batch_samples + MCRT_SAMPLES_PER_CHUNK - 1u) / MCRT_SAMPLES_PER_CHUNK;
     uint pixel = (uint)(g / chunks);
     if (pixel >= pixel_count) return;
     uint begin = (uint)(g % chunks) * MCRT_SAMPLES_PER_CHUNK;
     uint end = min(begin + MCRT_SAMPLES_PER_CHUNK, batch_samples);
-    float3 s = (float3)(0.0f), s2 = (float3)(0.0f);
-    float bad = 0.0f, rays = 0.0f;
-    for (uint k = begin; k < end; ++k) {
-        float4 sample = samples[(size_t)pixel * batch_samples + k];
-        float3 v = sample.xyz;
-        rays += sample.w;
-        if (finite3(v)) {
-            s += v;
-            s2 += v * v;
-        } else {
-            bad += 1.0f;
+    global const float4* x = samples + (size_t)pixel * batch_samples;
+    for (uint r = 0u; r < replicates; ++r) {
+        /* The shift (first value) and the largest magnitude, per channel. */
+        float3 shift = (float3)(0.0f), largest = (float3)(0.0f);
+        float bad = 0.0f, rays = 0.0f, n = 0.0f;
+        for (uint k = begin + r; k < end; k += replicates) {
+            float4 sample = x[k];
+            bool ok = finite3(sample.xyz);
+            float3 v = ok ? sample.xyz : (float3)(0.0f);
+            if (n == 0.0f) shift = v;
+            largest = fmax(largest, fabs(v));
+            bad += ok ? 0.0f : 1.0f;
+            rays += sample.w;
+            n += 1.0f;
         }
+        /* 2^e at most the largest magnitude: scaled values are below 2 in magnitude. */
+        int3 e = select((int3)(0), ilogb(largest), largest > (float3)(0.0f));
+        float3 s = (float3)(0.0f), s2 = (float3)(0.0f);
+        float3 shift_scaled = ldexp(shift, -e);
+        for (uint k = begin + r; k < end; k += replicates) {
+            float3 v = x[k].xyz;
+            v = finite3(v) ? v : (float3)(0.0f);
+            float3 d = ldexp(v, -e) - shift_scaled;
+            s += d;
+            s2 += d * d;
+        }
+        ChunkSums out;
+        out.shift = (float4)(shift, bad);
+        out.sum = (float4)(s, rays);
+        out.sum_sq = (float4)(s2, n);
+        out.exponent = (float4)(convert_float3(e), 0.0f);
+        sums[g * replicates + r] = out;
     }
-    sums[g] = (float4)(s, bad);
-    sums_sq[g] = (float4)(s2, rays);
 }
 
 /* The device's view of every shared struct, in the order of MCRT_SHARED_LAYOUT: for each struct

@@ -23,19 +23,30 @@ inline uint4 pcg4d(uint4 v) {
 /* The 24 high bits as a float in [0, 1): exact, and never 1. */
 inline float uint_to_unit_float(uint x) { return (float)(x >> 8) * 0x1.0p-24f; }
 
-/* Identifies one pixel sample's stream of random numbers. */
+/* Identifies one pixel sample's stream of random numbers. A pixel's spp samples are split into
+ * `replicates` independent randomizations of the sampler (independent Owen scrambles, strata
+ * permutations, spiral rotations: L'Ecuyer & Lemieux 2002; Owen 1997), so that the spread of the
+ * replicate means is an honest error bar for correlated samples; `sample` and `sample_count`
+ * are within the replicate. */
 typedef struct {
     uint pixel;
-    uint sample;       /* index of the sample within the pixel */
-    uint sample_count; /* samples per pixel of the whole render (strata, spiral points) */
+    uint sample;       /* index of the sample within its replicate */
+    uint sample_count; /* samples per pixel per replicate (strata, spiral points, Sobol prefix) */
     uint seed;
+    uint replicate;    /* which randomization, 0 .. replicates − 1 */
+    uint index;        /* index of the sample within the pixel: replicate + replicates · sample */
 } SampleStream;
+
+/* The seed of this replicate's randomization: the render's seed for replicate 0. */
+inline uint replicate_seed(const SampleStream* s) { return s->seed ^ (s->replicate * 0x9E3779B9u); }
 
 /* Dimensions of the stream, shared by every estimator (a user's too) so that two estimators
  * are compared on the same samples (common random numbers). A 2D dimension d uses d and d + 1. */
 #define DIM_PIXEL_JITTER 0u   /* 2D */
-#define DIM_LIGHT_SELECT 2u   /* 1D */
-#define DIM_LIGHT_POINT 3u    /* 2D: point on the light, or direction in its spherical triangle */
+#define DIM_LIGHT_FINE 2u     /* 1D: refines DIM_LIGHT's x below the light selection's grid */
+#define DIM_LIGHT 3u          /* 2D: x chooses the light and, remapped, with y the point on it
+                                 (or the direction in its spherical triangle): one stratified
+                                 sample for both (discrete.cl) */
 #define DIM_DIRECTION 5u      /* 2D: hemisphere or BSDF direction (hemisphere, MIS, ambient) */
 #define DIM_PIXEL_ROTATION 7u /* 2D, per pixel: rotation of the Fibonacci spiral */
 /* Dimensions DIM_USER, DIM_USER + 1, ... belong to users' estimators: no built-in code uses
@@ -49,12 +60,12 @@ inline float independent_1d(uint pixel, uint sample, uint dim, uint seed) {
 
 /* A hash key for one (pixel, dimension), the same for all samples of the pixel. */
 inline uint pixel_dimension_key(const SampleStream* s, uint dim) {
-    return pcg4d((uint4)(s->pixel, 0xffffffffu, dim, s->seed)).y;
+    return pcg4d((uint4)(s->pixel, 0xffffffffu, dim, replicate_seed(s))).y;
 }
 
 /* Numbers that depend on the pixel only, not on the sample (e.g. a per-pixel rotation). */
 inline float2 pixel_2d(const SampleStream* s, uint dim) {
-    uint4 h = pcg4d((uint4)(s->pixel, 0xfffffffeu, dim, s->seed));
+    uint4 h = pcg4d((uint4)(s->pixel, 0xfffffffeu, dim, replicate_seed(s)));
     return (float2)(uint_to_unit_float(h.x), uint_to_unit_float(h.y));
 }
 
@@ -96,7 +107,7 @@ inline uint kensler_permute(uint i, uint l, uint p) {
  * that pairs are not correlated; uniform jitter inside the stratum (PBRT 3rd ed. 7.3). */
 inline float sample_1d(const SampleStream* s, uint dim) {
     uint stratum = kensler_permute(s->sample, s->sample_count, pixel_dimension_key(s, dim));
-    float jitter = independent_1d(s->pixel, s->sample, dim, s->seed);
+    float jitter = independent_1d(s->pixel, s->index, dim, s->seed);
     return min(((float)stratum + jitter) / (float)s->sample_count, 0x1.fffffep-1f);
 }
 
@@ -105,8 +116,8 @@ inline float2 sample_2d(const SampleStream* s, uint dim) {
     while (nx * nx < s->sample_count) ++nx; /* float sqrt may round down */
     uint ny = (s->sample_count + nx - 1u) / nx;
     uint stratum = kensler_permute(s->sample, nx * ny, pixel_dimension_key(s, dim));
-    float2 jitter = (float2)(independent_1d(s->pixel, s->sample, dim, s->seed),
-                             independent_1d(s->pixel, s->sample, dim + 1u, s->seed));
+    float2 jitter = (float2)(independent_1d(s->pixel, s->index, dim, s->seed),
+                             independent_1d(s->pixel, s->index, dim + 1u, s->seed));
     float2 v = (float2)(((float)(stratum % nx) + jitter.x) / (float)nx,
                         ((float)(stratum / nx) + jitter.y) / (float)ny);
     return min(v, (float2)(0x1.fffffep-1f));
@@ -164,7 +175,7 @@ inline float sample_1d(const SampleStream* s, uint dim) {
 
 #else /* SAMPLER_INDEPENDENT */
 inline float sample_1d(const SampleStream* s, uint dim) {
-    return independent_1d(s->pixel, s->sample, dim, s->seed);
+    return independent_1d(s->pixel, s->index, dim, s->seed);
 }
 
 /* Dimensions dim and dim + 1. */

@@ -115,16 +115,19 @@ kernel void fibonacci_samples(uint n, uint index, uint count, uint seed, global 
     out[k] = (float4)(w, sample_hemisphere_fibonacci_pdf_w(w));
 }
 
-/* Reads cdf (n + 1 entries) or the alias table (n entries) by method (0 CDF, 1 alias); writes
- * out[k] = (index, pmf bits) for k < count, u hashed from (k, seed). */
+/* Reads cdf (n + 1 entries) or the alias table (n entries) by method (0 CDF, 1 alias,
+ * 2 uniform); writes out[k] = (index, pmf bits, u_remap bits, 0) for k < count, u and u_fine
+ * hashed from (k, seed). */
 kernel void sample_discrete(uint method, global const float* cdf, global const AliasEntry* table,
-                            uint n, uint count, uint seed, global uint2* out) {
+                            uint n, uint count, uint seed, global uint4* out) {
     uint k = (uint)get_global_id(0);
     if (k >= count) return;
-    float u = uint_to_unit_float(pcg4d((uint4)(k, seed, 0xD15Cu, 0u)).x);
-    DiscreteSample s =
-        method == 0u ? sample_discrete_cdf(cdf, n, u) : sample_discrete_alias(table, n, u);
-    out[k] = (uint2)(s.index, as_uint(s.pmf));
+    uint4 h = pcg4d((uint4)(k, seed, 0xD15Cu, 0u));
+    float u = uint_to_unit_float(h.x), u_fine = uint_to_unit_float(h.y);
+    DiscreteSample s = method == 0u   ? sample_discrete_cdf(cdf, n, u, u_fine)
+                       : method == 1u ? sample_discrete_alias(table, n, u, u_fine)
+                                      : sample_discrete_uniform(n, u, u_fine);
+    out[k] = (uint4)(s.index, as_uint(s.pmf), as_uint(s.u_remap), 0u);
 }
 
 /* Reads cdf or table as sample_discrete; writes pmf[i] = the distribution's pmf of i < n. */

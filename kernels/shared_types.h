@@ -155,8 +155,22 @@ typedef struct {
     uint pixel_begin, pixel_end; /* this launch: pixels [pixel_begin, pixel_end) */
     uint sample_begin;  /* this launch: samples [sample_begin, sample_begin + batch_samples) */
     uint batch_samples; /*   of each pixel */
-    uint pad0, pad1;
+    uint replicates;    /* K independent randomizations of the sampler: sample s belongs to
+                           replicate s % K as its sample s / K of spp / K (K divides 16 and spp) */
+    uint pad0;
 } RenderParams;
+
+/* What reduce_chunks writes for one run of samples: the samples of one pixel, one chunk and one
+ * replicate, 64 bytes. The sums are shifted by the run's first value and scaled by a power of
+ * two per channel (2^-e, 2^e the largest magnitude in the run), so that a run of equal values
+ * sums to exactly zero spread and no square overflows, up to float's range (Chan, Golub &
+ * LeVeque 1983 on shifted sums). Non-finite samples are counted and read as 0. */
+typedef struct {
+    float4 shift;    /* .xyz the run's first sample, .w non-finite samples in the run */
+    float4 sum;      /* .xyz Σ (x·2^-e − shift·2^-e), .w rays traced */
+    float4 sum_sq;   /* .xyz Σ (x·2^-e − shift·2^-e)², .w samples in the run */
+    float4 exponent; /* .xyz e, whole numbers; .w unused */
+} ChunkSums;
 
 /* The render kernel's arguments in order (kernels/render.cl); the host binds them all in one
  * place (bind_render_arguments, host/render/device_worker.cpp). */
@@ -169,7 +183,7 @@ enum RenderArgument {
     RENDER_ARG_LIGHT_CDF,     /* global const float*: light_count + 1 entries */
     RENDER_ARG_LIGHT_ALIAS,   /* global const AliasEntry*: light_count entries */
     RENDER_ARG_CAMERA,        /* global const CameraGpu* */
-    RENDER_ARG_SAMPLES,       /* global float4*: out, one per work-item */
+    RENDER_ARG_SAMPLES,       /* global float4*: out, one per work-item (radiance, rays) */
     RENDER_ARG_PARAMS,        /* RenderParams, by value */
     RENDER_ARG_COUNT
 };
@@ -199,7 +213,10 @@ enum RenderArgument {
     FIELD(RenderParams, width, 20) FIELD(RenderParams, height, 24) FIELD(RenderParams, seed, 28) \
     FIELD(RenderParams, spp, 32) FIELD(RenderParams, light_count, 36)                           \
     FIELD(RenderParams, pixel_begin, 40) FIELD(RenderParams, pixel_end, 44)                     \
-    FIELD(RenderParams, sample_begin, 48) FIELD(RenderParams, batch_samples, 52)
+    FIELD(RenderParams, sample_begin, 48) FIELD(RenderParams, batch_samples, 52)                 \
+    FIELD(RenderParams, replicates, 56)                                                         \
+    TYPE(ChunkSums, 64, 16) FIELD(ChunkSums, shift, 0) FIELD(ChunkSums, sum, 16)                \
+    FIELD(ChunkSums, sum_sq, 32) FIELD(ChunkSums, exponent, 48)
 
 #ifndef __OPENCL_VERSION__
 #define MCRT_CHECK_TYPE(T, size, align) \

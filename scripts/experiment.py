@@ -18,9 +18,11 @@ every row (`reference_rmse_floor`) and drawn as a floor on the charts.
 
 Reference (--reference auto): the lowest-variance estimator mcrt has for direct light, `mis`
 with `power` light selection and the `sobol` sampler, at --reference-spp (default 4096) spp, as
-two half renders with different seeds averaged. Its noise floor is measured from the halves:
-E[(a − b)²]/4 is the MSE of (a + b)/2 whatever the sampler (the variance layer overstates the
-error of Sobol samples, docs/EXPERIMENTS.md). It is cached in
+two half renders with different seeds averaged. Its noise floor is its variance layer, honest
+for Sobol samples since it comes from independent replicates (issue 13; the two halves'
+E[(a − b)²]/4 is kept beside it as a cross-check). Every row's `layer_rmse` is the render's own
+error bar the same way (√ of its variance layer's mean, bias excluded): error bars for every
+sampler, from one render. It is cached in
 $XDG_CACHE_HOME/mcrt/references/ (else ~/.cache/mcrt/references/), keyed by a hash of the
 scene file (and its .bin buffers), the image size and the settings, with a provenance JSON.
 --reference FILE.exr uses that image (its variance layer gives the floor).
@@ -63,7 +65,8 @@ ROOT = mcrt_run.ROOT
 RELMSE_EPSILON = 1e-2
 REFERENCE_SEEDS = (1000003, 2000003)  # far from the seeds of the measured renders
 CSV_COLUMNS = ["scene", "estimator", "light_select", "sampler", "level", "spp", "repeat", "seed",
-               "seconds", "wall_seconds", "rmse", "relmse", "mse", "efficiency",
+               "seconds", "wall_seconds", "rmse", "layer_rmse", "replicates", "relmse", "mse",
+               "efficiency",
                "rel_efficiency", "reference_rmse_floor", "reference_relrmse_floor", "image_mean", "nan_samples"]
 
 
@@ -150,23 +153,26 @@ def auto_reference(args, scene, scratch):
     rgb = (a + b) / 2
     variance = (va + vb) / 4
     split_mse = float(np.mean((a - b) ** 2) / 4)       # MSE of the mean of the two halves
-    split_relmse = float(np.mean((a - b) ** 2 / 4 / (rgb ** 2 + RELMSE_EPSILON)))
-    layer_mse = float(np.mean(variance))               # what the variance layer claims
+    layer_mse = float(np.mean(variance))               # what the variance layers say
+    layer_relmse = float(np.mean(variance / (rgb ** 2 + RELMSE_EPSILON)))
     info = {
         "scene": str(scene), "scene_sha256": scene_hash(scene), "settings": settings,
         "commands": commands, "mcrt_commit": git_commit(),
         "date": datetime.datetime.now().astimezone().isoformat(timespec="seconds"),
         "spp": 2 * half, "seconds_render": seconds, "wall_seconds": wall,
         "image_mean": float(rgb.mean()),
-        # sqrt of the variance layer per pixel, averaged: the per-pixel standard error the
-        # layer claims (an upper bound with Sobol samples)
+        # sqrt of the variance layer per pixel, averaged: the per-pixel standard error
         "standard_error_layer": float(np.mean(np.sqrt(variance))),
+        # the floor used: the reference's RMSE from its variance layers, honest for Sobol
+        # samples since they come from replicates (issue 13)
         "rmse_floor_layer": math.sqrt(layer_mse),
-        # the reference's RMSE measured from its two independent halves: the floor used
-        "rmse_floor": math.sqrt(split_mse),
-        "relrmse_floor": math.sqrt(split_relmse),
+        "rmse_floor": math.sqrt(layer_mse),
+        "relrmse_floor": math.sqrt(layer_relmse),
+        # the same measured from the two independent halves, a cross-check of the layer
+        "rmse_floor_halves": math.sqrt(split_mse),
         "note": "reference = mean of two half renders with different seeds; rmse_floor = "
-                "sqrt(mean((a-b)^2)/4); the layer values overstate the error of Sobol samples",
+                "sqrt(mean of the variance layers / 4) (replicate-based for Sobol); "
+                "rmse_floor_halves = sqrt(mean((a-b)^2)/4)",
     }
     cache.mkdir(parents=True, exist_ok=True)
     write_exr(exr_path, {"R": rgb[0], "G": rgb[1], "B": rgb[2], "variance.R": variance[0],
@@ -430,9 +436,9 @@ def main(argv=None):
     rel_floor = ref_info.get("relrmse_floor", 0.0)
     (out / "reference.json").write_text(json.dumps(dict(ref_info, path=str(ref_path)), indent=1)
                                         + "\n")
-    print("experiment: reference %s: %s spp, RMSE floor %.3g (variance layer says %.3g)"
-          % (ref_path, ref_info.get("spp"), floor, ref_info.get("rmse_floor_layer", float("nan"))),
-          file=sys.stderr)
+    print("experiment: reference %s: %s spp, RMSE floor %.3g from its variance layer (its two "
+          "halves say %.3g)" % (ref_path, ref_info.get("spp"), floor,
+                                ref_info.get("rmse_floor_halves", float("nan"))), file=sys.stderr)
 
     levels = args.spp if args.spp else args.seconds
     rows, images, configs = [], {}, []
@@ -455,7 +461,11 @@ def main(argv=None):
                         row = {"scene": scene.name, "estimator": name, "light_select": select,
                                "sampler": sampler, "level": level, "spp": stats["spp"],
                                "repeat": repeat, "seed": seed, "seconds": seconds,
-                               "wall_seconds": wall, "rmse": math.sqrt(mse), "relmse": relmse,
+                               "wall_seconds": wall, "rmse": math.sqrt(mse),
+                               # the render's own error bar: √ of its variance layer's mean,
+                               # honest for every sampler (replicates), bias excluded
+                               "layer_rmse": math.sqrt(float(np.mean(r.variance))),
+                               "replicates": stats.get("replicates", 1), "relmse": relmse,
                                "mse": mse,
                                "efficiency": 1.0 / (mse * seconds) if mse > 0 and seconds > 0
                                else float("inf"),

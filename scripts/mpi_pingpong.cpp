@@ -44,7 +44,6 @@ int main(int argc, char** argv) {
             wire::ResultMessage m;
             m.result.item = *got;
             m.result.sums.resize(got->pixel_count());
-            m.result.sums_sq.resize(got->pixel_count());
             mpi::send_bytes(wire::encode_result(m), 0, mpi::result_tag(0));
         }
     }

@@ -5,19 +5,22 @@ For each (estimator, sampler): K renders with independent seeds; the observed va
 image mean across seeds is compared with the one the variance layer predicts,
 mean(variance layer) / pixels (pixels are independent). A ratio above 1 means the layer
 overstates the error. Prints a Markdown table. The samplers are those of `mcrt variants`; the
-estimators built-in names or estimator files FILE.cl. Only the standard library: the figures
-are those of the stats JSON.
+estimators built-in names or estimator files FILE.cl. Two comparisons: per pixel (the variance
+of each pixel across the K renders against the layer, both averaged over pixels: precise, as
+pixels are independent) and on the image mean (one number per render: noisier).
 
 Usage: scripts/variance_layer.py [--scene S] [--size WxH] [--spp N] [--renders K]
                                  [--estimators a,b,...] [--mcrt BINARY]
 """
 import argparse
-import statistics
 import sys
 import tempfile
 from pathlib import Path
 
 import mcrt_run
+
+mcrt_run.require("numpy")
+import numpy as np  # noqa: E402
 
 
 def main():
@@ -33,24 +36,34 @@ def main():
     pixels = width * height
     estimators = mcrt_run.comma_list(args.estimators)
     mcrt_run.check_estimators(estimators, args.mcrt)
-    print("| estimator | sampler | observed var of image mean | layer's prediction | "
-          "layer / observed |")
-    print("|---|---|---|---|---|")
+    print("| estimator | sampler | replicates | per pixel: observed var | layer | layer / observed "
+          "| image mean: observed var | layer's prediction | layer / observed |")
+    print("|---|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as out:
         for estimator in estimators:
             for sampler in mcrt_run.names("samplers", mcrt=args.mcrt):
-                means, predicted = [], []
+                rgb, layer, replicates = [], [], set()
                 for seed in range(args.renders):
-                    s = mcrt_run.render(args.scene, Path(out) / "i", mcrt_run.estimator_arguments(
+                    r = mcrt_run.render(args.scene, Path(out) / "i", mcrt_run.estimator_arguments(
                         estimator) + ["--width", width, "--height", height, "--spp", args.spp,
-                                      "--seed", seed, "--sampler", sampler],
-                        mcrt=args.mcrt, read_image=False).stats
-                    means.append(sum(s["image_mean"]) / 3)
-                    predicted.append(sum(s["image_mean_variance"]) / 3 / pixels)
-                observed = statistics.variance(means)
-                layer = statistics.mean(predicted)
-                print(f"| {mcrt_run.estimator_label(estimator)} | {sampler} | {observed:.3e} | "
-                      f"{layer:.3e} | {layer / observed:.2f} |", flush=True)
+                                      "--seed", seed, "--sampler", sampler], mcrt=args.mcrt)
+                    rgb.append(r.rgb)
+                    layer.append(r.variance)
+                    replicates.add(r.stats.get("replicates", 1))
+                rgb, layer = np.stack(rgb), np.stack(layer)
+                # Per pixel: the variance of each pixel across the renders, averaged over pixels
+                # and channels, against the layer averaged the same way (pixels are independent,
+                # so this is the precise comparison).
+                px_observed = float(rgb.var(axis=0, ddof=1).mean())
+                px_layer = float(layer.mean())
+                # Image mean: its variance across renders, against mean(layer) / pixels (noisier:
+                # one number per render, and heavy tails weigh on it).
+                observed = float(rgb.mean(axis=(2, 3)).var(axis=0, ddof=1).mean())
+                predicted = float(layer.mean(axis=(0, 2, 3)).mean()) / pixels
+                print(f"| {mcrt_run.estimator_label(estimator)} | {sampler} | "
+                      f"{'/'.join(map(str, sorted(replicates)))} | {px_observed:.3e} | "
+                      f"{px_layer:.3e} | {px_layer / px_observed:.2f} | {observed:.3e} | "
+                      f"{predicted:.3e} | {predicted / observed:.2f} |", flush=True)
 
 
 if __name__ == "__main__":

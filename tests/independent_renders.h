@@ -3,6 +3,7 @@
 // layer's prediction, and any non-finite output. Shared by test_estimators and test_stress.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -61,6 +62,9 @@ struct Renders {
     std::vector<glm::dvec3> means;  // image mean of each independent render
     glm::dvec3 mean{0.0}, standard_error{0.0};
     double mean_layer_variance = 0;  // mean over renders of the variance layer's image mean
+    // Per pixel, averaged over pixels and channels: the variance of a pixel's value across the
+    // renders (what the layer should predict), and the layer's value averaged over the renders.
+    double pixel_variance_observed = 0, pixel_variance_layer = 0;
     uint64_t nan_samples = 0;
     size_t non_finite_pixels = 0;  // pixels with a NaN or Inf in rgb or variance, over all renders
 };
@@ -70,9 +74,16 @@ inline Renders independent_renders(const DeviceContext& device, const GpuSceneDa
                                    RenderSettings settings, int count, uint32_t first_seed) {
     Renders r;
     const size_t n = size_t(settings.width) * settings.height;
+    std::vector<double> pixel_sum(3 * n, 0.0), pixel_sum_sq(3 * n, 0.0);
     for (int k = 0; k < count; ++k) {
         settings.seed = first_seed + uint32_t(k);
         RenderResult result = render(device, data, settings);
+        for (size_t i = 0; i < 3 * n; ++i) {
+            const double v = result.image.rgb[i];
+            pixel_sum[i] += v;
+            pixel_sum_sq[i] += v * v;
+            r.pixel_variance_layer += result.image.variance[i] / double(3 * n * count);
+        }
         glm::dvec3 m(0.0);
         double layer = 0;
         for (size_t p = 0; p < n; ++p) {
@@ -90,6 +101,9 @@ inline Renders independent_renders(const DeviceContext& device, const GpuSceneDa
         r.mean_layer_variance += layer / count;
         r.nan_samples += result.nan_samples;
     }
+    for (size_t i = 0; i < 3 * n; ++i)
+        r.pixel_variance_observed += std::max(0.0, pixel_sum_sq[i] - pixel_sum[i] * pixel_sum[i] / count) /
+                                     double(count - 1) / double(3 * n);
     glm::dvec3 var(0.0);
     for (const glm::dvec3& m : r.means) var += (m - r.mean) * (m - r.mean) / double(count - 1);
     r.standard_error = glm::sqrt(var / double(count));

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "image/image.h"
@@ -272,6 +273,9 @@ TEST_CASE("bad usage exits 2 with one error line and writes nothing", "[cli]") {
         {"device bogus", render({"--device", "bogus"}), {"--device", "bogus"}},
         {"sky -1", render({"--sky", "-1"}), {"--sky"}},
         {"sky with two values", render({"--sky", "1,2"}), {"--sky"}},
+        {"replicates 3", render({"--replicates", "3"}), {"--replicates", "3"}},
+        {"replicates not dividing spp", render({"--replicates", "8", "--spp", "12"}), {"--replicates", "12"}},
+        {"replicates 32", render({"--replicates", "32"}), {"--replicates"}},
     };
     for (const Case& c : cases) {
         Sandbox box;
@@ -484,5 +488,27 @@ TEST_CASE("a scene without a camera renders with the bench camera", "[cli][share
         CHECK(red(16, 16) == Approx(1.0f).epsilon(1e-3));
         CHECK(red(0, 0) == 0.0f);
         CHECK(red(31, 0) == 0.0f);
+    }
+}
+
+TEST_CASE("the EXR and the stats say which variance estimate the layer holds", "[cli][variance]") {
+    for (const auto& [sampler, replicates, spp] :
+         {std::make_tuple("independent", "1", "16"), std::make_tuple("sobol", "2", "16"),
+          std::make_tuple("sobol", "2", "6"), std::make_tuple("stratified", "1", "1")}) {
+        Sandbox box;
+        ProcessResult r = box.run({"render", kCornell, "--out", box.out("x.exr"), "--stats",
+                                   box.out("x.json"), "--sampler", sampler, "--spp", spp, "--width",
+                                   "16", "--height", "16", "--quiet"});
+        INFO(sampler << ", spp " << spp << ": " << r.err);
+        REQUIRE(r.exit_code == 0);
+        std::ifstream in(box.out("x.json"));
+        nlohmann::json j = nlohmann::json::parse(in);
+        CHECK(std::to_string(j["replicates"].get<int>()) == replicates);
+        CHECK(j["variance_estimate"] == (std::string(replicates) == "1" ? "samples" : "replicates"));
+        std::ifstream exr(box.out("x.exr"), std::ios::binary);
+        std::string bytes((std::istreambuf_iterator<char>(exr)), std::istreambuf_iterator<char>());
+        CHECK(bytes.find("mcrt.replicates") != std::string::npos);
+        CHECK(bytes.find(std::string(replicates) == "1" ? "the samples' variance over their number"
+                                                        : "independent replicate means") != std::string::npos);
     }
 }

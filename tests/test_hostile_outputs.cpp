@@ -268,7 +268,7 @@ TEST_CASE("error messages name the real cause", "[cli][hostile]") {
 }
 
 TEST_CASE("an image too large for host memory is refused before rendering", "[memory][hostile]") {
-    const uint64_t need = render_host_bytes(16384, 16384);
+    const uint64_t need = render_host_bytes(16384, 16384, 1);
     CHECK(need > uint64_t(16384) * 16384 * 120);  // accumulator doubles and image floats at least
     CHECK_THROWS_AS(check_host_memory("x", ~uint64_t(0) / 2), RuntimeError);
     CHECK_NOTHROW(check_host_memory("x", 1));

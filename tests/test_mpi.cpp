@@ -145,18 +145,21 @@ TEST_CASE("MPI messages: inputs, hellos, items and results read back as written"
     m.seconds_run = 0.5;
     m.result.item = item;
     for (int k = 0; k < 64; ++k) {
-        m.result.sums.push_back({float(k), 1.5f, -2.0f, 0.0f});
-        m.result.sums_sq.push_back({float(k * k), 2.25f, 4.0f, 7.0f});
+        gpu::ChunkSums c{};
+        c.shift = {float(k), 1.5f, -2.0f, 0.0f};
+        c.sum = {float(k * k), 2.25f, 4.0f, 7.0f};
+        c.exponent = {1.0f, 2.0f, 3.0f, 0.0f};
+        m.result.sums.push_back(c);
     }
     wire::Bytes result_bytes = wire::encode_result(m);
-    CHECK(result_bytes.size() == 72 + 64 * 32);
+    CHECK(result_bytes.size() == 80 + 64 * 64);
     wire::ResultMessage back = wire::decode_result(result_bytes, item);
     CHECK_FALSE(back.failed);
     CHECK(back.target_samples == 5000);
     CHECK(back.samples == 1024);
     CHECK(back.seconds_run == 0.5);
-    CHECK(std::memcmp(back.result.sums.data(), m.result.sums.data(), 64 * 16) == 0);
-    CHECK(std::memcmp(back.result.sums_sq.data(), m.result.sums_sq.data(), 64 * 16) == 0);
+    REQUIRE(back.result.sums.size() == 64);
+    CHECK(std::memcmp(back.result.sums.data(), m.result.sums.data(), 64 * 64) == 0);
     // The result of another item, a cut message, a failure.
     WorkItem other = item;
     other.seq = 43;

@@ -69,6 +69,11 @@ TEST_CASE("two devices render the image of one device, bit for bit, both doing w
           "[multidevice]") {
     Devices devices;
     Fixture f;
+    // Independent samples (one replicate) and Sobol split into 8 replicates (200 = 8 · 25).
+    auto [sampler, replicates] = GENERATE(std::make_pair("independent", 1u), std::make_pair("sobol", 8u));
+    f.settings.sampler = sampler;
+    f.settings.replicates = replicates;
+    INFO(sampler << ", " << replicates << " replicate(s)");
     RenderResult one = render(std::vector<const DeviceContext*>{devices.all[0]}, f.data, f.settings);
     RenderResult other = render(std::vector<const DeviceContext*>{devices.all[1]}, f.data, f.settings);
     RenderResult both = render(devices.all, f.data, f.settings);
@@ -88,6 +93,8 @@ TEST_CASE("two devices render the image of one device, bit for bit, both doing w
     f.settings.batch = 48;
     RenderResult fixed = render(devices.all, f.data, f.settings);
     CHECK(same_bits(one.image.rgb, fixed.image.rgb));
+    CHECK(same_bits(one.image.variance, fixed.image.variance));
+    CHECK(fixed.replicates == replicates);
 }
 
 TEST_CASE("a device that fails mid-render is retired and the image is unchanged",

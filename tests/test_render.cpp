@@ -126,6 +126,12 @@ TEST_CASE("the image is bitwise identical for any batch size, and changes with t
     settings.width = 16;
     settings.height = 12;
     settings.spp = 40;  // not a multiple of the chunk: the last chunk is short
+    // Replicates included: each chunk holds 16 / K samples of each of the K replicates.
+    auto [sampler, replicates] = GENERATE(std::make_pair("independent", 1u), std::make_pair("sobol", 4u),
+                                          std::make_pair("stratified", 8u));
+    settings.sampler = sampler;
+    settings.replicates = replicates;
+    INFO(sampler << ", " << replicates << " replicate(s)");
     settings.batch = 16;
     RenderResult a = render_scene(ps.scene, ps.camera, settings);
     settings.batch = 48;
@@ -166,4 +172,37 @@ TEST_CASE("batch sizes are whole chunks and never exceed the samples asked for",
     CHECK(batch_samples_per_pixel(0, 64, 64, 1024) == 1024);
     CHECK(batch_samples_per_pixel(0, 64, 64, 20) == 32);        // covers spp in one launch
     CHECK(batch_samples_per_pixel(0, 16384, 16384, 4) == 16);
+}
+
+TEST_CASE("an emitter of 1e30 renders a finite image and variance layer", "[render][variance]") {
+    // Float sums of squares overflowed at radiance 4.6e18 before the device shifted and scaled
+    // them: a pixel of constant 1e30 then showed an infinite variance.
+    Scene scene;
+    uint32_t floor = add_material(scene, glm::vec3(0.5f));
+    add_quad(scene, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, floor);
+    uint32_t light = add_material(scene, glm::vec3(0.0f), glm::vec3(1e30f));
+    // Facing +Y, seen from above, covering the middle of the view.
+    add_quad(scene, {-0.3f, 0.5f, -0.3f}, {-0.3f, 0.5f, 0.3f}, {0.3f, 0.5f, 0.3f}, {0.3f, 0.5f, -0.3f}, light);
+    Camera camera = looking_down(glm::vec3(0.0f, 3.0f, 0.0f), glm::radians(60.0f));
+    RenderSettings settings;
+    settings.width = 16;
+    settings.height = 16;
+    settings.spp = 32;
+    for (const char* estimator : {"light-area", "hemisphere-cosine"}) {
+        settings.estimator = estimator;
+        RenderResult r = render_scene(scene, camera, settings);
+        INFO(estimator << ": " << r.variance_clamped << " variance values clamped to FLT_MAX");
+        size_t light_pixels = 0;
+        for (size_t i = 0; i < r.image.rgb.size(); ++i) {
+            REQUIRE(std::isfinite(r.image.rgb[i]));
+            REQUIRE(std::isfinite(r.image.variance[i]));
+            // A pixel wholly on the emitter: every sample exactly 1e30, no spread at all.
+            if (r.image.rgb[i] == 1e30f) {
+                CHECK(r.image.variance[i] == 0.0f);
+                ++light_pixels;
+            }
+        }
+        CHECK(light_pixels > 0);
+        CHECK(r.nan_samples == 0);
+    }
 }

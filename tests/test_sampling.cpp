@@ -836,7 +836,7 @@ TEST_CASE("discrete samplers report their pmf and match the weights (chi2)",
         double total = std::accumulate(w.begin(), w.end(), 0.0);
         cl_uint n = cl_uint(w.size());
         cl::Buffer cdf = d.buffer(build_cdf(w)), table = d.buffer(build_alias_table(w));
-        cl::Buffer out = d.output<cl_uint2>(kSamples), pmf = d.output<float>(n);
+        cl::Buffer out = d.output<cl_uint4>(kSamples), pmf = d.output<float>(n);
         std::vector<float> pmfs[2];
         std::vector<double> frequency[2];
         for (cl_uint method : {0u, 1u}) {
@@ -848,10 +848,10 @@ TEST_CASE("discrete samplers report their pmf and match the weights (chi2)",
                   Approx(1.0).epsilon(1e-6));
             d.run("sample_discrete", kSamples, method, cdf, table, n, cl_uint(kSamples),
                   cl_uint(50 + vector_index), out);
-            std::vector<cl_uint2> s = d.read<cl_uint2>(out, kSamples);
+            std::vector<cl_uint4> s = d.read<cl_uint4>(out, kSamples);
             std::vector<double> observed(n, 0.0), expected(n);
             size_t wrong_pmf = 0, zero_selected = 0, out_of_range = 0;
-            for (const cl_uint2& x : s) {
+            for (const cl_uint4& x : s) {
                 if (x.s[0] >= n) {
                     ++out_of_range;
                     continue;
@@ -881,6 +881,48 @@ TEST_CASE("discrete samplers report their pmf and match the weights (chi2)",
         }
         // Same distribution: the two pmfs agree within the CDF's rounding.
         for (cl_uint i = 0; i < n; ++i) CHECK(std::abs(pmfs[0][i] - pmfs[1][i]) <= 0x1.0p-22);
+    }
+}
+
+TEST_CASE("the remapped selection number is uniform within every choice (chi2)",
+          "[sampling][discrete]") {
+    // A light's triangle and the point on it come from one sample: given the choice, u_remap
+    // must be uniform on [0, 1), also for choices of one grid step (the 1e-20 weight).
+    Device& d = device();
+    constexpr int kBins = 16;
+    int vector_index = 0;
+    for (const std::vector<double>& w : weight_vectors()) {
+        ++vector_index;
+        cl_uint n = cl_uint(w.size());
+        cl::Buffer cdf = d.buffer(build_cdf(w)), table = d.buffer(build_alias_table(w));
+        cl::Buffer out = d.output<cl_uint4>(kSamples);
+        for (cl_uint method : {0u, 1u, 2u}) {
+            const char* name = method == 0 ? "CDF" : method == 1 ? "alias" : "uniform";
+            d.run("sample_discrete", kSamples, method, cdf, table, n, cl_uint(kSamples),
+                  cl_uint(90 + vector_index), out);
+            std::vector<cl_uint4> s = d.read<cl_uint4>(out, kSamples);
+            std::vector<double> observed(size_t(n) * kBins, 0.0), count(n, 0.0);
+            size_t outside = 0;
+            for (const cl_uint4& x : s) {
+                float r;
+                std::memcpy(&r, &x.s[2], sizeof r);
+                if (x.s[0] >= n || !(r >= 0.0f && r < 1.0f)) {
+                    ++outside;
+                    continue;
+                }
+                observed[size_t(x.s[0]) * kBins + size_t(r * kBins)] += 1;
+                count[x.s[0]] += 1;
+            }
+            INFO("weights " << vector_index << ", " << name);
+            CHECK(outside == 0);
+            // Expected: the choice's count spread evenly over the bins; choices seen too rarely
+            // for a χ² cell are pooled by chi2_test's rule.
+            std::vector<double> expected(observed.size());
+            for (size_t k = 0; k < expected.size(); ++k) expected[k] = count[k / kBins] / kBins;
+            Chi2 r = chi2_test("remap " + std::string(name) + " weights " + std::to_string(vector_index),
+                               observed, expected);
+            CHECK(r.statistic < r.critical);
+        }
     }
 }
 

@@ -207,7 +207,10 @@ const Failure kFailures[] = {
      "uniform selection with radiances 10^6 apart"},
     {"light-facing-away", "light-area / power", "light-area / uniform", 2,
      "power selection ignores orientation: it mostly picks the light facing away"},
-    {"reflecting-emitters", "light-area / power", "light-solid-angle / power", 2,
+    // Measured 1.8-2.5x on the image mean (16 seeds, 32 spp, before and after the light sample
+    // was shared by the choice and the point; 2.0-2.3x per pixel): 1.5 leaves room for the
+    // noise of a ratio of two standard errors from 16 renders.
+    {"reflecting-emitters", "light-area / power", "light-solid-angle / power", 1.5,
      "area sampling of the wall from floor points 0.02 below it"},
 };
 

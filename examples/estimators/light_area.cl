@@ -5,7 +5,7 @@
  *         --estimator-file examples/estimators/light_area.cl
  *
  * renders the image of `--estimator light-area`, bit for bit, with any sampler and light
- * selection: the same random numbers (DIM_LIGHT_SELECT, DIM_LIGHT_POINT) and the same arithmetic.
+ * selection: the same random numbers (DIM_LIGHT, DIM_LIGHT_FINE) and the same arithmetic.
  *
  * The random variable is (light, point on it): the light with probability pmf (--light-select),
  * the point uniform on its area (density pdf_a = 1/area). The estimate of the reflected radiance
@@ -16,8 +16,8 @@ float3 estimate(const SceneView* scene, const SurfacePoint* sp, const SampleStre
                 uint* rays) {
     /* Light strategy: a light, a point on it; invalid when there is no light or its back
      * faces the shading point. */
-    LightSample ls = sample_light_area(scene, sp, sample_1d(stream, DIM_LIGHT_SELECT),
-                                       sample_2d(stream, DIM_LIGHT_POINT));
+    LightSample ls = sample_light_area(scene, sp, sample_2d(stream, DIM_LIGHT),
+                                       sample_1d(stream, DIM_LIGHT_FINE));
     float cos_x = dot(sp->n, ls.wi);
     if (!ls.valid || cos_x <= 0.0f) return (float3)(0.0f); /* below the shading point's horizon */
 

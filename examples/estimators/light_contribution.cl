@@ -15,8 +15,9 @@
  * w_i > 0, so the estimator is unbiased whatever the weights' quality. The light is chosen by
  * walking the weights with u · Σw (two passes over the lights: O(lights) per sample, for scenes
  * of tens to hundreds of lights — a light tree does it in O(log lights)); pmf = w_i / Σw; the
- * point is uniform on the light, as in light-area. The random numbers are light-area's
- * (DIM_LIGHT_SELECT, DIM_LIGHT_POINT): the two compare on common random numbers. */
+ * point is uniform on the light, as in light-area, from the same 2D sample: its x, remapped
+ * within the chosen light's share of [0, 1), and its y. The random numbers are light-area's
+ * (DIM_LIGHT): the two compare on common random numbers. */
 
 #define CONTRIBUTION_COSINE_FLOOR 0.05f
 
@@ -53,23 +54,27 @@ float3 estimate(const SceneView* scene, const SurfacePoint* sp, const SampleStre
         total += light_importance(sp, &light);
     }
     if (!(total > 0.0f)) return (float3)(0.0f); /* no light can reach this point */
-    float target = sample_1d(stream, DIM_LIGHT_SELECT) * total;
+    float2 u = sample_2d(stream, DIM_LIGHT);
+    float target = u.x * total;
     uint chosen = n;
-    float w_chosen = 0.0f, running = 0.0f;
+    float w_chosen = 0.0f, running = 0.0f, start = 0.0f;
     for (uint i = 0u; i < n; ++i) {
         Light light = scene->lights.lights[i];
         float w = light_importance(sp, &light);
         if (w <= 0.0f) continue;
         chosen = i; /* the last light with weight, should rounding leave target beyond the sum */
         w_chosen = w;
+        start = running;
         running += w;
         if (target < running) break;
     }
     float pmf = w_chosen / total;
+    /* Where target fell in the chosen light's share, rescaled: uniform again, for the point. */
+    float u_remap = clamp((target - start) / w_chosen, 0.0f, 0x1.fffffep-1f);
 
     /* A uniform point on the chosen light (density 1/area), as light-area. */
     Light light = scene->lights.lights[chosen];
-    LightPoint lp = sample_light_point(&light, sample_2d(stream, DIM_LIGHT_POINT));
+    LightPoint lp = sample_light_point(&light, (float2)(u_remap, u.y));
     float3 to_light = lp.p - sp->p;
     float d2 = dot(to_light, to_light);
     if (!(d2 > 0.0f)) return (float3)(0.0f);

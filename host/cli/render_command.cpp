@@ -70,7 +70,7 @@ glm::vec3 parse_sky(const std::string& text) {
                 throw std::invalid_argument(item);
             v.push_back(x);
         } catch (const std::exception&) {
-            throw InputError("--sky " + text + ": expected R,G,B or one value, each in [0, 1e15]");
+            throw InputError("--sky " + text + ": expected R,G,B or one value, each in [0, 1e30]");
         }
     }
     if (v.size() == 1) return glm::vec3(v[0]);
@@ -106,6 +106,7 @@ RenderSettings render_settings(const RenderOptions& o, const std::string* estima
     settings.ao_distance = o.ao_distance;
     settings.seed = o.seed;
     settings.batch = o.batch;
+    settings.replicates = resolve_replicates(o.replicates, settings);
     render_program_options(settings);  // rejects what is not supported before any work
     return settings;
 }
@@ -167,6 +168,12 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
     cmd->add_option("--batch", o.batch, "samples per pixel per launch (0 chooses)")
         ->capture_default_str()
         ->check(CLI::Range(0u, 1u << 24));
+    cmd->add_option("--replicates", o.replicates,
+                    "independent randomizations of the sampler that the variance layer is "
+                    "estimated from (1, 2, 4, 8, 16 dividing --spp; 0: 1 for independent samples, "
+                    "else " + std::to_string(kDefaultReplicates) + " or the largest power of two dividing --spp)")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, 16u));
     cmd->add_option("--stats", o.stats, "write statistics as JSON");
     cmd->add_option("--time-limit", o.time_limit, "stop after this many seconds")
         ->check(kFinite)
@@ -197,7 +204,7 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     Scene scene = load_gltf(o.scene, print_warning, &inputs, job ? &files : nullptr);
     check_outputs(outputs, inputs);  // its buffers too
     check_host_memory("a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " render",
-                      render_host_bytes(o.width, o.height));
+                      render_host_bytes(o.width, o.height, settings.replicates));
     if (scene.triangle_count() == 0) print_warning(o.scene + ": the scene has no triangles");
     unsigned uses =
         o.estimator_file.empty() ? estimator_variant(o.estimator).uses : kUserEstimatorUses;
@@ -247,7 +254,13 @@ int render_here(const RenderOptions& o, RenderJob* job) {
         {"mcrt.light_select", o.light_select},
         {"mcrt.sampler", o.sampler},
         {"mcrt.seed", std::to_string(o.seed)},
-        {"mcrt.mis_heuristic", o.mis_heuristic}};
+        {"mcrt.mis_heuristic", o.mis_heuristic},
+        {"mcrt.replicates", std::to_string(result.replicates)},
+        {"mcrt.variance",
+         result.replicates > 1
+             ? "variance of the pixel mean from the spread of " + std::to_string(result.replicates) +
+                   " independent replicate means"
+             : "variance of the pixel mean: the samples' variance over their number"}};
     write_exr(o.out, result.image, attributes);
     if (!o.png.empty()) write_png(o.png, result.image, o.exposure);
 

@@ -23,6 +23,7 @@ struct RenderOptions {
     int camera = -1;
     std::vector<std::string> devices;
     uint32_t batch = 0;
+    uint32_t replicates = 0;  // 0: the default (resolve_replicates)
     double time_limit = 0.0;
     float exposure = 0.0f;
     bool quiet = false;

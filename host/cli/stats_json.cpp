@@ -37,6 +37,9 @@ nlohmann::json render_stats_json(const RenderStatsInput& in) {
         {"rays", result.rays},
         {"rays_per_second", result.seconds_render > 0 ? result.rays / result.seconds_render : 0.0},
         {"nan_samples", result.nan_samples},
+        {"replicates", result.replicates},
+        {"variance_estimate", result.replicates > 1 ? "replicates" : "samples"},
+        {"variance_clamped", result.variance_clamped},
         {"nonfinite_pixels", 0},  // run_render writes no image with any
         {"triangles", in.scene.triangle_count()},
         {"lights", in.gpu_scene.lights.size()},

@@ -185,10 +185,9 @@ Bytes encode_result(const ResultMessage& m) {
     w.u64(m.samples);
     w.f64(m.seconds_busy);
     w.f64(m.seconds_run);
-    // The item's sums, then its sums of squares: their count follows from the item.
-    w.bytes.reserve(w.bytes.size() + 2 * m.result.sums.size() * sizeof(gpu::float4));
-    w.raw(m.result.sums.data(), m.result.sums.size() * sizeof(gpu::float4));
-    w.raw(m.result.sums_sq.data(), m.result.sums_sq.size() * sizeof(gpu::float4));
+    // The item's runs (pixel × chunk × replicate), as the device wrote them.
+    w.u64(m.result.sums.size());
+    w.raw(m.result.sums.data(), m.result.sums.size() * sizeof(gpu::ChunkSums));
     return std::move(w.bytes);
 }
 
@@ -213,11 +212,13 @@ ResultMessage decode_result(const Bytes& bytes, const WorkItem& item) {
     m.seconds_busy = r.f64();
     m.seconds_run = r.f64();
     m.result.item = item;
-    const size_t n = size_t(item.pixel_count()) * item.chunk_count();
-    m.result.sums.resize(n);
-    m.result.sums_sq.resize(n);
-    r.raw(m.result.sums.data(), n * sizeof(gpu::float4));
-    r.raw(m.result.sums_sq.data(), n * sizeof(gpu::float4));
+    const uint64_t runs = r.u64();
+    const uint64_t per_replicate = uint64_t(item.pixel_count()) * item.chunk_count();
+    if (runs == 0 || per_replicate == 0 || runs % per_replicate != 0 ||
+        runs > bytes.size() / sizeof(gpu::ChunkSums))
+        throw RuntimeError("MPI: a result whose sums do not fit its work item");
+    m.result.sums.resize(size_t(runs));
+    r.raw(m.result.sums.data(), size_t(runs) * sizeof(gpu::ChunkSums));
     r.done();
     return m;
 }

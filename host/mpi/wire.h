@@ -36,9 +36,9 @@ Hello decode_hello(const Bytes& bytes);
 Bytes encode_item(const std::optional<WorkItem>& item);
 std::optional<WorkItem> decode_item(const Bytes& bytes);
 
-// That device → rank 0: the item's per-chunk sums with what the report needs, or the error
-// that retired the device. 72 bytes of header + 32 bytes per pixel and chunk of the item (two
-// float4 sums per 16 samples: 2 bytes per sample).
+// That device → rank 0: the item's per-run sums (gpu::ChunkSums, 64 bytes per pixel, chunk and
+// replicate) with what the report needs, or the error that retired the device. 80 bytes of
+// header + 64 bytes per run: 4 bytes per sample with one replicate.
 struct ResultMessage {
     bool failed = false;
     std::string error;            // when failed

@@ -1,12 +1,15 @@
 #include "render/accumulator.h"
 
 #include <algorithm>
+#include <cfloat>
+#include <cmath>
 
 namespace mcrt {
 
-Accumulator::Accumulator(uint32_t pixels, uint32_t spp)
-    : pixels_(pixels), spp_(spp), sum_(3 * size_t(pixels)), sum_sq_(3 * size_t(pixels)),
-      row_sum_(3 * size_t(pixels)), row_sum_sq_(3 * size_t(pixels)) {}
+Accumulator::Accumulator(uint32_t pixels, uint32_t spp, uint32_t replicates)
+    : pixels_(pixels), spp_(spp), replicates_(replicates),
+      mean_(3 * size_t(pixels) * replicates), m2_(replicates == 1 ? 3 * size_t(pixels) : 0),
+      row_mean_(mean_.size()), row_m2_(m2_.size()) {}
 
 void Accumulator::submit(BatchResult result) {
     uint64_t seq = result.item.seq;
@@ -20,21 +23,30 @@ void Accumulator::submit(BatchResult result) {
 
 void Accumulator::apply(const BatchResult& r) {
     const WorkItem& item = r.item;
-    const uint32_t chunks = item.chunk_count();
+    const uint32_t chunks = item.chunk_count(), K = replicates_;
     for (uint32_t c = 0; c < chunks; ++c) {
         for (uint32_t p = 0; p < item.pixel_count(); ++p) {
-            const gpu::float4& s = r.sums[size_t(p) * chunks + c];
-            const gpu::float4& s2 = r.sums_sq[size_t(p) * chunks + c];
-            size_t k = 3 * size_t(item.pixel_begin + p);
-            // Within a row each pixel receives one chunk: the row buffer holds it exactly.
-            row_sum_[k + 0] = s.x;
-            row_sum_[k + 1] = s.y;
-            row_sum_[k + 2] = s.z;
-            row_sum_sq_[k + 0] = s2.x;
-            row_sum_sq_[k + 1] = s2.y;
-            row_sum_sq_[k + 2] = s2.z;
-            row_nan_ += uint64_t(s.w);
-            row_rays_ += uint64_t(s2.w);
+            for (uint32_t k = 0; k < K; ++k) {
+                const gpu::ChunkSums& s = r.sums[(size_t(p) * chunks + c) * K + k];
+                const double n = s.sum_sq.w;
+                const size_t at = 3 * (size_t(item.pixel_begin + p) * K + k);
+                const float shift[3] = {s.shift.x, s.shift.y, s.shift.z};
+                const float sum[3] = {s.sum.x, s.sum.y, s.sum.z};
+                const float sum_sq[3] = {s.sum_sq.x, s.sum_sq.y, s.sum_sq.z};
+                const float exponent[3] = {s.exponent.x, s.exponent.y, s.exponent.z};
+                // Within a row each pixel receives one run per replicate: the row holds it.
+                for (int ch = 0; ch < 3; ++ch) {
+                    const double scale = std::ldexp(1.0, int(exponent[ch]));
+                    row_mean_[at + ch] = double(shift[ch]) + double(sum[ch]) * scale / n;
+                    if (K == 1) {
+                        const double d = double(sum[ch]);
+                        row_m2_[at + ch] = std::max(0.0, double(sum_sq[ch]) - d * d / n) * scale * scale;
+                    }
+                }
+                row_n_ = n;  // the same for every pixel of a row: its chunk, over K
+                row_nan_ += uint64_t(s.shift.w);
+                row_rays_ += uint64_t(s.sum.w);
+            }
         }
         row_pixels_ += item.pixel_count();
         if (row_pixels_ == pixels_) commit_row();
@@ -42,10 +54,14 @@ void Accumulator::apply(const BatchResult& r) {
 }
 
 void Accumulator::commit_row() {
-    for (size_t k = 0; k < sum_.size(); ++k) {
-        sum_[k] += row_sum_[k];
-        sum_sq_[k] += row_sum_sq_[k];
+    // Chan, Golub & LeVeque 1983: (n_a, mean_a, M2_a) ⊕ (n_b, mean_b, M2_b).
+    const double n_a = n_, n_b = row_n_, n = n_a + n_b;
+    for (size_t k = 0; k < mean_.size(); ++k) {
+        const double delta = row_mean_[k] - mean_[k];
+        mean_[k] += delta * (n_b / n);
+        if (!m2_.empty()) m2_[k] += row_m2_[k] + delta * delta * (n_a * n_b / n);
     }
+    n_ = n;
     nan_samples_ += row_nan_;
     rays_ += row_rays_;
     row_nan_ = row_rays_ = 0;
@@ -59,17 +75,34 @@ uint32_t Accumulator::committed_spp() const {
 
 Image Accumulator::image(int width, int height) const {
     Image img(width, height);
-    uint32_t spp = committed_spp();
-    img.spp = spp;
-    if (spp == 0) return img;
-    double n = spp;
-    for (size_t k = 0; k < sum_.size(); ++k) {
-        double mean = sum_[k] / n;
-        img.rgb[k] = float(mean);
-        // Variance of the pixel mean: the sample variance (n − 1 denominator) over n.
-        double var = n > 1 ? std::max(0.0, (sum_sq_[k] - sum_[k] * mean) / (n - 1)) / n : 0.0;
-        img.variance[k] = float(var);
-    }
+    img.spp = committed_spp();
+    if (img.spp == 0) return img;
+    const uint32_t K = replicates_;
+    const double spp = img.spp;
+    variance_clamped_ = 0;
+    for (size_t p = 0; p < size_t(pixels_); ++p)
+        for (int ch = 0; ch < 3; ++ch) {
+            double mean = 0, var = 0;
+            if (K == 1) {
+                mean = mean_[3 * p + ch];
+                // The sample variance (n − 1 denominator) over n: the variance of the mean.
+                var = spp > 1 ? m2_[3 * p + ch] / (spp - 1) / spp : 0.0;
+            } else {
+                for (uint32_t k = 0; k < K; ++k) mean += mean_[3 * (p * K + k) + ch] / K;
+                // The spread of K independent replicate means: the variance of their mean.
+                for (uint32_t k = 0; k < K; ++k) {
+                    const double d = mean_[3 * (p * K + k) + ch] - mean;
+                    var += d * d;
+                }
+                var /= double(K) * double(K - 1);
+            }
+            img.rgb[3 * p + ch] = float(mean);
+            if (var > double(FLT_MAX)) {
+                var = FLT_MAX;
+                ++variance_clamped_;
+            }
+            img.variance[3 * p + ch] = float(var);
+        }
     return img;
 }
 

@@ -83,21 +83,28 @@ DeviceWorker::DeviceWorker(const DeviceContext& device, const GpuSceneData& scen
     max_samples_ =
         std::min<uint64_t>(uint64_t(1) << 22, device.info.max_allocation / 4 / sizeof(gpu::float4));
     if (fixed_batch_ > 0) max_samples_ = std::max(max_samples_, fixed_batch_);
-    uint64_t needed = buffers_->bytes + max_samples_ * sizeof(gpu::float4) * 3;
+    // Samples and, at 16 samples a chunk, their runs' sums (grown on demand when spp < 16).
+    uint64_t needed = buffers_->bytes + max_samples_ * sizeof(gpu::float4) +
+                      (max_samples_ / MCRT_SAMPLES_PER_CHUNK + 1) * settings.replicates *
+                          sizeof(gpu::ChunkSums);
     if (needed > device.info.global_memory)
         throw RuntimeError(
             "device '" + device.info.name + "' has " + std::to_string(device.info.global_memory) +
             " bytes of memory; the scene and batch buffers need " + std::to_string(needed));
     samples_ = device_buffer(device, CL_MEM_READ_WRITE,
                              round_up(max_samples_, kGroupSize) * sizeof(gpu::float4), "samples");
-    // Up to one sum per sample, when spp < one chunk.
-    sums_ = device_buffer(device, CL_MEM_WRITE_ONLY, max_samples_ * sizeof(gpu::float4), "sums");
-    sums_sq_ = device_buffer(device, CL_MEM_WRITE_ONLY, max_samples_ * sizeof(gpu::float4), "sums");
 
     bind_render_arguments(render_, *buffers_, samples_);
     CL_CHECK(reduce_.setArg(0, samples_));
-    CL_CHECK(reduce_.setArg(3, sums_));
-    CL_CHECK(reduce_.setArg(4, sums_sq_));
+    CL_CHECK(reduce_.setArg(3, cl_uint(settings.replicates)));
+}
+
+void DeviceWorker::reserve_sums(uint64_t runs) {
+    if (runs <= sums_capacity_) return;
+    sums_capacity_ = std::max<uint64_t>(runs, max_samples_ / MCRT_SAMPLES_PER_CHUNK);
+    sums_ = device_buffer(device_, CL_MEM_WRITE_ONLY, sums_capacity_ * sizeof(gpu::ChunkSums),
+                          "chunk sums");
+    CL_CHECK(reduce_.setArg(4, sums_));
 }
 
 uint64_t DeviceWorker::target_samples() const {
@@ -133,8 +140,11 @@ BatchResult DeviceWorker::run(const WorkItem& item) {
     params.pixel_end = item.pixel_end;
     params.sample_begin = sample_begin;
     params.batch_samples = n;
+    params.replicates = settings_.replicates;
     CL_CHECK(render_.setArg(gpu::RENDER_ARG_PARAMS, sizeof params, &params));
     const cl_uint chunks = item.chunk_count();
+    const uint64_t runs = uint64_t(item.pixel_count()) * chunks * settings_.replicates;
+    reserve_sums(runs);
     CL_CHECK(reduce_.setArg(1, n));
     CL_CHECK(reduce_.setArg(2, cl_uint(item.pixel_count())));
 
@@ -150,11 +160,9 @@ BatchResult DeviceWorker::run(const WorkItem& item) {
         cl::NDRange(kGroupSize), nullptr, &reduce_done));
     BatchResult result;
     result.item = item;
-    result.sums.resize(size_t(item.pixel_count()) * chunks);
-    result.sums_sq.resize(result.sums.size());
-    size_t bytes = result.sums.size() * sizeof(gpu::float4);
-    CL_CHECK(device_.queue.enqueueReadBuffer(sums_, CL_FALSE, 0, bytes, result.sums.data()));
-    CL_CHECK(device_.queue.enqueueReadBuffer(sums_sq_, CL_TRUE, 0, bytes, result.sums_sq.data()));
+    result.sums.resize(runs);
+    CL_CHECK(device_.queue.enqueueReadBuffer(sums_, CL_TRUE, 0, runs * sizeof(gpu::ChunkSums),
+                                             result.sums.data()));
     double busy = event_seconds(render_done) + event_seconds(reduce_done);
     if (slow_factor_ > 1.0)  // simulate a slower device (MCRT_SLOW_DEVICE)
         std::this_thread::sleep_for(std::chrono::duration<double>(busy * (slow_factor_ - 1.0)));

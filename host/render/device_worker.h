@@ -38,6 +38,11 @@ class DeviceWorker : public RenderWorker {
     // Adds the last successful launch to the report; the caller holds the render's lock.
     void commit_report() override;
 
+private:
+    // Makes the sums buffer hold `runs` ChunkSums, reallocating when it is smaller.
+    void reserve_sums(uint64_t runs);
+
+
   private:
     const DeviceContext& device_;
     const RenderSettings& settings_;
@@ -49,7 +54,8 @@ class DeviceWorker : public RenderWorker {
     uint64_t pending_samples_ = 0;
     cl::Kernel render_, reduce_;
     std::unique_ptr<GpuSceneBuffers> buffers_;
-    cl::Buffer samples_, sums_, sums_sq_;
+    cl::Buffer samples_, sums_;
+    uint64_t sums_capacity_ = 0;  // ChunkSums the sums_ buffer holds
 };
 
 }  // namespace mcrt

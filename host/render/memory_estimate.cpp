@@ -30,8 +30,12 @@ uint64_t read_cgroup_value(const char* path) {
 
 }  // namespace
 
-uint64_t render_host_bytes(int width, int height) {
-    return with_margin(uint64_t(width) * uint64_t(height) * (96 + 24 + 6));
+uint64_t render_host_bytes(int width, int height, unsigned replicates) {
+    // Per pixel: the accumulator's committed and row means (2 × 3 doubles per replicate) and,
+    // with one replicate, squared deviations (2 × 3 doubles); the float image and variance (24);
+    // PNG bytes (6); 96 for the rest (EXR and result copies).
+    const uint64_t accumulator = 2 * 3 * 8 * uint64_t(replicates) + (replicates == 1 ? 48 : 0);
+    return with_margin(uint64_t(width) * uint64_t(height) * (96 + 24 + 6 + accumulator));
 }
 
 uint64_t bench_host_bytes(int width, int height) {

@@ -7,10 +7,11 @@
 
 namespace mcrt {
 
-// Bytes per pixel a render holds on the host: the accumulator's four double sums per channel
-// (committed and the chunk row being filled: 96), the float image and variance (24), the PNG's
-// 8-bit pixels and encoding (about 6), plus 10 % for what the estimate leaves out.
-uint64_t render_host_bytes(int width, int height);
+// Bytes a render holds on the host: per pixel the accumulator's double means per replicate and
+// channel (committed and the chunk row being filled) and, with one replicate, squared
+// deviations; the float image and variance (24); the PNG's 8-bit pixels and encoding (about 6);
+// 96 more for copies; plus 10 % for what the estimate leaves out.
+uint64_t render_host_bytes(int width, int height, unsigned replicates);
 
 // Bytes per ray `mcrt bench` holds on the host (rays, hits, surface points, occlusion results).
 uint64_t bench_host_bytes(int width, int height);

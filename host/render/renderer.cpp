@@ -11,9 +11,28 @@
 #include "render/device_worker.h"
 #include "render/render_program.h"
 #include "render/render_worker.h"
+#include "render/variants.h"
 #include "render/work_queue.h"
 
 namespace mcrt {
+
+uint32_t resolve_replicates(uint32_t requested, const RenderSettings& settings) {
+    if (requested > 0) {
+        if (MCRT_SAMPLES_PER_CHUNK % requested != 0 || settings.spp % requested != 0)
+            throw InputError("--replicates " + std::to_string(requested) +
+                             ": expected 1, 2, 4, 8 or 16, dividing --spp " +
+                             std::to_string(settings.spp));
+        return requested;
+    }
+    const bool correlated =
+        settings.sampler != "independent" ||
+        (settings.estimator_file.empty() &&
+         (estimator_variant(settings.estimator).uses & kUsesCorrelatedSamples));
+    if (!correlated) return 1;  // independent samples: their own variance is honest
+    uint32_t k = kDefaultReplicates;
+    while (settings.spp % k != 0) k /= 2;  // the largest power of two up to it dividing spp
+    return k;
+}
 
 uint32_t batch_samples_per_pixel(uint32_t requested, int width, int height, uint32_t spp) {
     const uint32_t chunk = MCRT_SAMPLES_PER_CHUNK;
@@ -31,6 +50,10 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
                     const RemoteWorkers& remote) {
     auto start = std::chrono::steady_clock::now();
     render_program_options(settings);  // rejects unknown settings before any device work
+    if (settings.replicates == 0 || MCRT_SAMPLES_PER_CHUNK % settings.replicates != 0 ||
+        settings.spp % settings.replicates != 0)
+        throw InputError("--replicates " + std::to_string(settings.replicates) +
+                         ": must divide 16 and --spp " + std::to_string(settings.spp));
     const uint32_t pixels = uint32_t(settings.width) * uint32_t(settings.height);
     const uint64_t fixed_batch =
         settings.batch > 0
@@ -57,7 +80,7 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
     RenderResult result;
     result.seconds_build = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     WorkQueue queue(pixels, settings.spp);
-    Accumulator acc(pixels, settings.spp);
+    Accumulator acc(pixels, settings.spp, settings.replicates);
     std::mutex acc_mutex;
 
     auto device_reports = [&] {
@@ -130,6 +153,8 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
     result.spp = acc.committed_spp();
     result.image = acc.image(settings.width, settings.height);
     result.nan_samples = acc.nan_samples();
+    result.replicates = acc.replicates();
+    result.variance_clamped = acc.variance_clamped();
     result.rays = acc.rays();
     result.devices = device_reports();
     for (const DeviceReport& d : result.devices) result.seconds_render += d.seconds_busy;

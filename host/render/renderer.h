@@ -30,6 +30,9 @@ struct RenderSettings {
     float ao_distance = 0.0f;   // ambient estimators: occlusion range, 0 = unbounded
     uint32_t seed = 0;
     uint32_t batch = 0;  // samples per pixel per launch; 0 chooses; rounded up to whole chunks
+    // Independent randomizations of the sampler the variance layer is estimated from (1: the
+    // samples' own variance); divides 16 and spp. resolve_replicates() chooses it from 0.
+    uint32_t replicates = 1;
 };
 
 struct DeviceReport {
@@ -49,6 +52,8 @@ using RemoteWorkers = std::function<std::vector<std::unique_ptr<RenderWorker>>()
 
 struct RenderResult {
     Image image;
+    uint32_t replicates = 1;     // what the variance layer was estimated from (1: the samples)
+    uint64_t variance_clamped = 0;  // variance values beyond float's range, written as FLT_MAX
     uint32_t spp = 0;            // samples per pixel in the image (fewer if stopped early)
     std::string stopped_by;      // "", "time limit" or "interrupt"
     uint64_t nan_samples = 0;    // non-finite samples, left out of the image
@@ -83,6 +88,11 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
 // One device, no early stop.
 RenderResult render(const DeviceContext& device, const GpuSceneData& scene,
                     const RenderSettings& settings);
+
+// Replicates for `requested` (0: the default for the settings' sampler and estimator, see
+// render/variants.h) with `spp` samples per pixel: a power of two dividing 16 and spp. Throws
+// InputError for a requested count that is not one.
+uint32_t resolve_replicates(uint32_t requested, const RenderSettings& settings);
 
 // Samples per pixel per launch when --batch is given: rounded up to whole chunks, at most spp
 // rounded up.

@@ -25,7 +25,7 @@ const std::vector<EstimatorVariant> kEstimatorVariants = {
      "ambient light: sky visibility over uniform directions, albedo x L_sky x (1/pi) int V cos"},
     {"ambient-cosine", "estimate_ambient_cosine", kUsesSky,
      "ambient light: sky visibility over cosine-weighted directions"},
-    {"ambient-fibonacci", "estimate_ambient_fibonacci", kUsesSky,
+    {"ambient-fibonacci", "estimate_ambient_fibonacci", kUsesSky | kUsesCorrelatedSamples,
      "ambient light: sky visibility over a perturbed spherical Fibonacci spiral of spp points"},
 };
 
@@ -96,6 +96,7 @@ std::vector<std::string> uses_names(unsigned uses) {
     if (uses & kUsesSky) names.push_back("sky");
     if (uses & kUsesMisHeuristic) names.push_back("mis-heuristic");
     if (uses & kUsesBsdfSampling) names.push_back("bsdf-sampling");
+    if (uses & kUsesCorrelatedSamples) names.push_back("correlated-samples");
     return names;
 }
 

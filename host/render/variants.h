@@ -18,6 +18,8 @@ enum EstimatorUses : unsigned {
     kUsesSky = 1u << 2,           // sees the uniform sky (--sky, --ao-distance); camera misses too
     kUsesMisHeuristic = 1u << 3,  // weights strategies with --mis-heuristic
     kUsesBsdfSampling = 1u << 4,  // draws directions from the BSDF
+    kUsesCorrelatedSamples = 1u << 5,  // a pixel's samples are correlated whatever the sampler
+                                       // (the Fibonacci spiral): error bars need replicates
 };
 
 struct EstimatorVariant {
@@ -59,6 +61,11 @@ constexpr unsigned kUserEstimatorUses = kUsesLights | kUsesLightSelection | kUse
 
 // The function a user's estimator file defines.
 constexpr const char* kUserEstimatorFunction = "estimate";
+
+// Replicates the variance layer is estimated from when the sampler (or the estimator) correlates
+// a pixel's samples and --replicates is not given: the trade-off between the error bar's own
+// noise and the QMC efficiency that splitting loses is measured in docs/EXPERIMENTS.md.
+constexpr unsigned kDefaultReplicates = 2;
 
 // Every table as JSON text (`mcrt variants --json`).
 std::string variants_json();

@@ -1095,7 +1095,7 @@ Material Importer::convert_material(int material_index, const std::string& refer
         if (max_component(Le) > kMaxRadiance) {
             diag_.fail(element, "emission " + format_number(max_component(Le)) + " exceeds " +
                                     format_number(kMaxRadiance) +
-                                    ", beyond which a pixel's sums overflow single precision");
+                                    ", beyond which an estimate may overflow single precision");
         }
     }
     material.double_sided = source.doubleSided;
