@@ -4,7 +4,7 @@ with the items, bytes and message overhead per work item from the stats' `ranks`
 
 Usage: scripts/bench_mpi.py [--scene S] [--size WxH] [--spp N] [--ranks 1,2,3] [--mcrt BINARY]
 Prints a Markdown table (docs/BENCHMARKS.md "Several processes (MPI)"). Rank counts run through
-`mpirun --oversubscribe -n K`; "1 (no mpirun)" is a plain render. Only the standard library.
+`mpirun --bind-to none --oversubscribe -n K`; "1 (no mpirun)" is a plain render. Only the standard library.
 """
 import argparse
 import json
@@ -22,9 +22,10 @@ def render(args, ranks, out_dir):
            "--spp", str(args.spp), "--quiet", "--out", str(out / "image.exr"),
            "--stats", str(out / "stats.json")]
     if ranks > 0:
-        cmd = ["mpirun", "--oversubscribe", "-n", str(ranks)] + cmd
-    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_btl_vader_single_copy_mechanism="none")
+        cmd = ["mpirun", "--bind-to", "none", "--oversubscribe", "-n", str(ranks)] + cmd
+    # Shared memory with CMA single copy (OpenMPI's default; a container may need
+    # OMPI_MCA_btl_vader_single_copy_mechanism=none, which makes large results slower).
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     subprocess.run(cmd, check=True, env=env)
     return json.loads((out / "stats.json").read_text())
 

@@ -68,7 +68,10 @@ std::vector<std::string> render_args(const std::string& out, std::vector<std::st
 // `mpirun -n ranks mcrt ARGS...`
 ProcessResult run_mpi(int ranks, const std::vector<std::string>& mcrt_args, const TempDir& dir,
                       double timeout = 60) {
-    std::vector<std::string> a = {"--oversubscribe", "-n", std::to_string(ranks), MCRT_EXE};
+    // --bind-to none: OpenMPI binds each of up to 2 ranks to one core by default, which halves
+    // a rank's CPU device (docs/MPI.md).
+    std::vector<std::string> a = {"--bind-to", "none", "--oversubscribe", "-n",
+                                  std::to_string(ranks), MCRT_EXE};
     a.insert(a.end(), mcrt_args.begin(), mcrt_args.end());
     return run_process(mpirun(), a, dir.path(), timeout);
 }
