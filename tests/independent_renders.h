@@ -110,4 +110,16 @@ inline Renders independent_renders(const DeviceContext& device, const GpuSceneDa
     return r;
 }
 
+// |mean − exact| within 4.5 standard errors in every channel, and no non-finite sample. With
+// 10 renders the standard error is itself uncertain (χ² with 9 degrees of freedom); 4.5 leaves
+// room for that.
+inline void check_unbiased(const Renders& r, glm::dvec3 exact, const std::string& what) {
+    INFO(what << ": mean (" << r.mean.x << ", " << r.mean.y << ", " << r.mean.z << "), exact ("
+              << exact.x << ", " << exact.y << ", " << exact.z << "), standard error ("
+              << r.standard_error.x << ", " << r.standard_error.y << ", " << r.standard_error.z
+              << ")");
+    CHECK(r.nan_samples == 0);
+    for (int c = 0; c < 3; ++c) CHECK(std::abs(r.mean[c] - exact[c]) <= 4.5 * r.standard_error[c]);
+}
+
 }  // namespace mcrt::test
