@@ -69,6 +69,18 @@ inline float3 estimate_hemisphere_cosine(const SceneView* scene, const SurfacePo
     return estimate_emitter_along(scene, sp, w, sample_hemisphere_cosine_pdf_w(w), rays);
 }
 
+/* Directions by the BSDF's own sampling density (bsdf.cl: cosine on a Lambertian surface, the
+ * density of hemisphere-cosine; GGX's visible normals for the specular lobe), counting the
+ * emitters they hit: f·Le·cosθ / pdf(ω). */
+inline float3 estimate_bsdf(const SceneView* scene, const SurfacePoint* sp,
+                            const SampleStream* stream, uint* rays) {
+    BsdfSample bs = bsdf_sample(sp, sample_2d(stream, DIM_DIRECTION));
+    if (!(bs.pdf_w > 0.0f) || bs.cos_theta <= 0.0f) return (float3)(0.0f);
+    SurfacePoint seen;
+    if (!trace_from(scene, sp, bs.wi, rays, &seen)) return (float3)(0.0f);
+    return bs.f * emitted_radiance(&seen) * (bs.cos_theta / bs.pdf_w);
+}
+
 /* ---- Multiple importance sampling -------------------------------------------------------- */
 
 /* One light-area sample and one BSDF sample, each weighted against the other's density

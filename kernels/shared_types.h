@@ -105,13 +105,22 @@ typedef struct {
 
 #define MATERIAL_DOUBLE_SIDED 1u
 
-/* Lambertian material that may emit, 48 bytes. */
+/* glTF 2.0 metallic-roughness material that may emit, 64 bytes (DESIGN.md "Radiometric
+ * contract"). Lambertian when metallic = 0 and the dielectric's F90 = 0 (then F0 = 0 too). */
 typedef struct {
-    float4 albedo; /* .xyz reflectance, .w unused */
-    float4 Le;     /* .xyz emitted radiance, .w unused */
-    uint flags;    /* MATERIAL_DOUBLE_SIDED */
+    float4 albedo;   /* .xyz baseColorFactor, .w metallicFactor */
+    float4 Le;       /* .xyz emitted radiance, .w GGX α = max(roughness², MCRT_ALPHA_MIN) */
+    float4 specular; /* the dielectric's Schlick terms (KHR_materials_specular): .xyz F0 =
+                        min(0.04 specularColorFactor, 1) × specularFactor, .w F90 =
+                        specularFactor */
+    uint flags;      /* MATERIAL_DOUBLE_SIDED */
     uint pad0, pad1, pad2;
 } Material;
+
+/* The least GGX α: roughness 0 (a mirror, a delta the estimators cannot sample) is read as
+ * α = 10⁻³, roughness ≈ 0.032, whose lobe is a few milliradians wide (pbrt-v4 treats α below
+ * 10⁻³ as smooth). */
+#define MCRT_ALPHA_MIN 1.0e-3f
 
 /* Emissive triangle for light sampling, 64 bytes. */
 typedef struct {
@@ -201,8 +210,8 @@ enum RenderArgument {
     TYPE(TriangleInfo, 8, 4) FIELD(TriangleInfo, material, 0) FIELD(TriangleInfo, light, 4)     \
     TYPE(Triangle, 48, 16) FIELD(Triangle, p0, 0) FIELD(Triangle, p1, 16)                       \
     FIELD(Triangle, p2, 32)                                                                     \
-    TYPE(Material, 48, 16) FIELD(Material, albedo, 0) FIELD(Material, Le, 16)                   \
-    FIELD(Material, flags, 32)                                                                  \
+    TYPE(Material, 64, 16) FIELD(Material, albedo, 0) FIELD(Material, Le, 16)                   \
+    FIELD(Material, specular, 32) FIELD(Material, flags, 48)                                    \
     TYPE(Light, 64, 16) FIELD(Light, p0, 0) FIELD(Light, p1, 16) FIELD(Light, p2, 32)           \
     FIELD(Light, Le, 48)                                                                        \
     TYPE(AliasEntry, 16, 4) FIELD(AliasEntry, threshold, 0) FIELD(AliasEntry, alias, 4)         \

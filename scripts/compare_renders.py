@@ -5,9 +5,11 @@ kernels or the host must leave unchanged.
 
     scripts/compare_renders.py --baseline OLD/mcrt [--mcrt build/mcrt] [--scene S.gltf]
         [--size 48] [--spp 32] [--seed 7] [--only mis,light-area]
+        [--new-options "--materials lambert"]
 
-The variants come from the new binary's `mcrt variants --json`; the old one is given the same
-command-line names. Prints one line per render and exits 1 when any image differs.
+The variants come from the new binary's `mcrt variants --json`, less the estimators the old
+one does not have; the old one is given the same command-line names, the new one also
+--new-options. Prints one line per render and exits 1 when any image differs.
 """
 
 import argparse
@@ -26,9 +28,10 @@ from mcrt_exr import read_exr  # noqa: E402
 def renders(args):
     """(label, options) of every combination."""
     table = mcrt_run.variants(args.mcrt)
+    old = set(e["name"] for e in mcrt_run.variants(args.baseline)["estimators"])
     only = set(args.only.split(",")) if args.only else None
     for e in table["estimators"]:
-        if only and e["name"] not in only:
+        if (only and e["name"] not in only) or e["name"] not in old:
             continue
         selections = mcrt_run.names("light_select", mcrt=args.mcrt)
         heuristics = (mcrt_run.names("mis_heuristics", mcrt=args.mcrt)
@@ -51,6 +54,8 @@ def main():
     parser.add_argument("--spp", type=int, default=32)
     parser.add_argument("--seed", type=int, default=7)
     parser.add_argument("--only", help="comma-separated estimators to compare")
+    parser.add_argument("--new-options", default="",
+                        help="options given to the new binary only (e.g. \"--materials lambert\")")
     args = parser.parse_args()
     common = ["--width", args.size, "--height", args.size, "--spp", args.spp, "--seed", args.seed]
     differ = 0
@@ -59,7 +64,9 @@ def main():
             images = []
             for which, binary in (("old", args.baseline), ("new", args.mcrt)):
                 stem = Path(scratch) / ("%d-%s" % (k, which))
-                mcrt_run.render(args.scene, stem, options + common, mcrt=binary, read_image=False)
+                extra = args.new_options.split() if which == "new" else []
+                mcrt_run.render(args.scene, stem, options + common + extra, mcrt=binary,
+                                read_image=False)
                 exr = read_exr(str(stem) + ".exr")
                 images.append({c: exr[c] for c in ("R", "G", "B", "variance.R", "variance.G",
                                                    "variance.B")})

@@ -102,6 +102,7 @@ RenderSettings render_settings(const RenderOptions& o, const std::string* estima
     settings.light_select = o.light_select;
     settings.sampler = o.sampler;
     settings.mis_heuristic = o.mis_heuristic;
+    settings.materials = o.materials;
     settings.sky = parse_sky(o.sky);
     settings.ao_distance = o.ao_distance;
     settings.seed = o.seed;
@@ -109,6 +110,10 @@ RenderSettings render_settings(const RenderOptions& o, const std::string* estima
     settings.replicates = resolve_replicates(o.replicates, settings);
     render_program_options(settings);  // rejects what is not supported before any work
     return settings;
+}
+
+void apply_materials_option(Scene& scene, const RenderSettings& settings) {
+    if (settings.materials == "lambert") make_lambertian(scene.materials);
 }
 
 Camera render_camera(const Scene& scene, const RenderOptions& o) {
@@ -155,6 +160,9 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
                     help_list("MIS weights (estimators that use them):", kMisHeuristicVariants))
         ->capture_default_str()
         ->check(CLI::IsMember(variant_names(kMisHeuristicVariants)));
+    cmd->add_option("--materials", o.materials, help_list("surfaces:", kMaterialVariants))
+        ->capture_default_str()
+        ->check(CLI::IsMember(variant_names(kMaterialVariants)));
     cmd->add_option("--seed", o.seed, "random seed")->capture_default_str();
     cmd->add_option("--sky", o.sky, "sky radiance R,G,B (ambient estimators)")
         ->capture_default_str();
@@ -202,6 +210,7 @@ int render_here(const RenderOptions& o, RenderJob* job) {
 
     FileBundle files;  // what the other ranks load the scene from
     Scene scene = load_gltf(o.scene, print_warning, &inputs, job ? &files : nullptr);
+    apply_materials_option(scene, settings);
     check_outputs(outputs, inputs);  // its buffers too
     check_host_memory("a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " render",
                       render_host_bytes(o.width, o.height, settings.replicates));
@@ -255,6 +264,7 @@ int render_here(const RenderOptions& o, RenderJob* job) {
         {"mcrt.sampler", o.sampler},
         {"mcrt.seed", std::to_string(o.seed)},
         {"mcrt.mis_heuristic", o.mis_heuristic},
+        {"mcrt.materials", o.materials},
         {"mcrt.replicates", std::to_string(result.replicates)},
         {"mcrt.variance",
          result.replicates > 1

@@ -17,6 +17,7 @@ struct RenderOptions {
     uint32_t spp = 16;
     std::string estimator = "light-area", estimator_file;
     std::string light_select = "power", sampler = "independent", mis_heuristic = "balance";
+    std::string materials = "gltf";
     uint32_t seed = 0;
     std::string sky = "1";
     float ao_distance = 0.0f;
@@ -42,5 +43,7 @@ int run_render(const RenderOptions& o);
 RenderSettings render_settings(const RenderOptions& o,
                                const std::string* estimator_source = nullptr);
 Camera render_camera(const Scene& scene, const RenderOptions& o);
+// The scene's materials as --materials reads them (lambert: every surface baseColor/π).
+void apply_materials_option(Scene& scene, const RenderSettings& settings);
 
 }  // namespace mcrt

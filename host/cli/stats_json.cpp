@@ -27,6 +27,8 @@ nlohmann::json render_stats_json(const RenderStatsInput& in) {
         {"sampler", o.sampler},
         {"seed", o.seed},
         {"mis_heuristic", o.mis_heuristic},
+        {"materials", o.materials},
+        {"microfacet", in.gpu_scene.microfacet},
         {"sky", {in.settings.sky.r, in.settings.sky.g, in.settings.sky.b}},
         {"ao_distance", o.ao_distance},
         {"seconds_total", in.seconds_total},

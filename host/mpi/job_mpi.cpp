@@ -249,6 +249,7 @@ int serve_render(const RenderOptions& o) {
         bytes = {};
         settings = render_settings(o, &estimator_source);
         Scene scene = load_gltf_from_bundle(o.scene, files, {});  // rank 0 printed its warnings
+        apply_materials_option(scene, settings);
         files.clear();
         const Camera camera = render_camera(scene, o);
         const std::vector<DeviceInfo> devices = select_devices(o.devices, warn);

@@ -73,7 +73,7 @@ DeviceWorker::DeviceWorker(const DeviceContext& device, const GpuSceneData& scen
     if (device_switch("MCRT_FAULT_INJECT", device.info.index, &v)) fail_at_launch_ = uint64_t(v);
     if (device_switch("MCRT_SLOW_DEVICE", device.info.index, &v)) slow_factor_ = std::max(1.0, v);
 
-    cl::Program program = render_program(device, settings);
+    cl::Program program = render_program(device, settings, scene.microfacet);
     render_ = make_kernel(program, "render");
     reduce_ = make_kernel(program, "reduce_chunks");
     buffers_ = std::make_unique<GpuSceneBuffers>(device, scene);

@@ -1,5 +1,6 @@
 #include "render/gpu_scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -30,10 +31,16 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
     data.packets = bvh.packets;
     for (const Material& m : scene.materials) {
         gpu::Material g{};
-        g.albedo = to_float4(m.albedo);
-        g.Le = to_float4(m.emission);
+        // KHR_materials_specular: the dielectric's F0 = min(0.04 specularColor, 1) × specular
+        // and F90 = specular; GGX α = roughness², at least MCRT_ALPHA_MIN.
+        const float alpha = std::max(m.roughness * m.roughness, MCRT_ALPHA_MIN);
+        g.albedo = to_float4(m.albedo, m.metallic);
+        g.Le = to_float4(m.emission, alpha);
+        g.specular = to_float4(glm::min(0.04f * m.specular_color, glm::vec3(1.0f)) * m.specular,
+                               m.specular);
         g.flags = m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u;
         data.materials.push_back(g);
+        data.microfacet = data.microfacet || !m.lambertian();
     }
     if (data.materials.empty()) data.materials.push_back(gpu::Material{});
 

@@ -23,6 +23,9 @@ struct GpuSceneData {
     std::vector<float> light_cdf;  // lights + 1 entries, by power (PBRT 3rd ed. 13.3.1)
     std::vector<gpu::AliasEntry> light_alias;  // the same distribution as an alias table
     gpu::CameraGpu camera{};
+    // Some surface is not Lambertian: the kernels need the microfacet BRDF (-D
+    // MCRT_MATERIALS_GLTF); a Lambertian scene's kernels are built without it.
+    bool microfacet = false;
 };
 
 // The camera of DESIGN.md's camera contract for an image of width × height.

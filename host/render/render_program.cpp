@@ -12,7 +12,7 @@
 
 namespace mcrt {
 
-std::string render_program_options(const RenderSettings& settings) {
+std::string render_program_options(const RenderSettings& settings, bool microfacet) {
     std::string options = "-cl-std=CL1.2";
     unsigned uses = kUserEstimatorUses;
     if (settings.estimator_file.empty()) {
@@ -31,6 +31,9 @@ std::string render_program_options(const RenderSettings& settings) {
         option_variant(kMisHeuristicVariants, settings.mis_heuristic, "--mis-heuristic");
     if ((uses & kUsesMisHeuristic) && heuristic.macro)
         options += std::string(" -D ") + heuristic.macro;
+    const OptionVariant& materials =
+        option_variant(kMaterialVariants, settings.materials, "--materials");
+    if (microfacet && materials.macro) options += std::string(" -D ") + materials.macro;
     return options;
 }
 
@@ -64,9 +67,10 @@ std::string first_error_in(const std::string& log, const std::string& file) {
 
 }  // namespace
 
-cl::Program render_program(const DeviceContext& device, const RenderSettings& settings) {
+cl::Program render_program(const DeviceContext& device, const RenderSettings& settings,
+                           bool microfacet) {
     try {
-        return cached_program(device, "render.cl", render_program_options(settings),
+        return cached_program(device, "render.cl", render_program_options(settings, microfacet),
                               render_program_replacements(settings));
     } catch (const RuntimeError& e) {
         if (settings.estimator_file.empty()) throw;

@@ -12,8 +12,9 @@ namespace mcrt {
 
 struct RenderSettings;
 
-// The -D options of the render program (throws InputError for a name no table has).
-std::string render_program_options(const RenderSettings& settings);
+// The -D options of the render program (throws InputError for a name no table has);
+// `microfacet`: the scene has a surface that is not Lambertian (GpuSceneData::microfacet).
+std::string render_program_options(const RenderSettings& settings, bool microfacet = false);
 
 // The user's estimator file, if any, as the replacement of kernels/user_estimator.cl.
 KernelReplacements render_program_replacements(const RenderSettings& settings);
@@ -21,7 +22,8 @@ KernelReplacements render_program_replacements(const RenderSettings& settings);
 // The render program built (once per process) for the device. A build error in a user's
 // estimator file throws InputError whose first line names FILE:LINE and the compiler's message,
 // followed by the build log; any other build failure throws RuntimeError with the log.
-cl::Program render_program(const DeviceContext& device, const RenderSettings& settings);
+cl::Program render_program(const DeviceContext& device, const RenderSettings& settings,
+                           bool microfacet);
 
 // The text of a user's estimator file; throws InputError when it is not a readable regular file
 // or defines no `estimate` function.

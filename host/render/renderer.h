@@ -26,6 +26,7 @@ struct RenderSettings {
     std::string light_select = "power";    // kLightSelectVariants
     std::string sampler = "independent";   // kSamplerVariants
     std::string mis_heuristic = "balance"; // kMisHeuristicVariants
+    std::string materials = "gltf";        // kMaterialVariants (the scene is read accordingly)
     glm::vec3 sky{1.0f};        // ambient estimators: uniform sky radiance
     float ao_distance = 0.0f;   // ambient estimators: occlusion range, 0 = unbounded
     uint32_t seed = 0;

@@ -13,6 +13,9 @@ const std::vector<EstimatorVariant> kEstimatorVariants = {
      "Compendium eq. 34)"},
     {"hemisphere-cosine", "estimate_hemisphere_cosine", kUsesLights,
      "cosine-weighted directions, pdf cos/pi, counting the emitters they hit (eq. 35)"},
+    {"bsdf", "estimate_bsdf", kUsesLights | kUsesBsdfSampling,
+     "directions by the BSDF's sampling density (cosine for Lambertian, GGX visible normals for "
+     "glossy lobes), counting the emitters they hit"},
     {"light-area", "estimate_light_area", kUsesLights | kUsesLightSelection,
      "a light by --light-select and a uniform point on it, pdf pmf/area converted by cos_y/d^2"},
     {"light-solid-angle", "estimate_light_solid_angle", kUsesLights | kUsesLightSelection,
@@ -20,7 +23,7 @@ const std::vector<EstimatorVariant> kEstimatorVariants = {
      "area below 3e-4 sr"},
     {"mis", "estimate_mis",
      kUsesLights | kUsesLightSelection | kUsesMisHeuristic | kUsesBsdfSampling,
-     "one light-area and one BSDF sample, weighted by --mis-heuristic (Veach 1997)"},
+     "one light-area and one BSDF-sampled direction, weighted by --mis-heuristic (Veach 1997)"},
     {"ambient-uniform", "estimate_ambient_uniform", kUsesSky,
      "ambient light: sky visibility over uniform directions, albedo x L_sky x (1/pi) int V cos"},
     {"ambient-cosine", "estimate_ambient_cosine", kUsesSky,
@@ -49,6 +52,13 @@ const std::vector<OptionVariant> kSamplerVariants = {
 const std::vector<OptionVariant> kMisHeuristicVariants = {
     {"balance", nullptr, "w_a = p_a / (p_a + p_b)"},
     {"power", "MIS_POWER", "w_a = p_a^2 / (p_a^2 + p_b^2), beta = 2"},
+};
+
+const std::vector<OptionVariant> kMaterialVariants = {
+    {"gltf", "MCRT_MATERIALS_GLTF",
+     "glTF 2.0 metallic-roughness (Appendix B: GGX, height-correlated Smith, Schlick; "
+     "KHR_materials_specular), as the file says"},
+    {"lambert", nullptr, "every surface Lambertian, baseColor/pi (the course's model)"},
 };
 
 namespace {
@@ -120,6 +130,7 @@ std::string variants_json() {
         {"light_select", options(kLightSelectVariants)},
         {"samplers", options(kSamplerVariants)},
         {"mis_heuristics", options(kMisHeuristicVariants)},
+        {"materials", options(kMaterialVariants)},
         {"user_estimator",
          {{"function", kUserEstimatorFunction}, {"uses", uses_names(kUserEstimatorUses)}}}};
     return j.dump(2) + "\n";
@@ -143,6 +154,8 @@ std::string variants_text() {
     options("light selection (--light-select):\n", kLightSelectVariants);
     options("samplers (--sampler):\n", kSamplerVariants);
     options("MIS heuristics (--mis-heuristic):\n", kMisHeuristicVariants);
+    options("materials (--materials; the macro only for a scene that is not all Lambertian):\n",
+            kMaterialVariants);
     out += "a user's estimator (--estimator-file FILE.cl) defines float3 " +
            std::string(kUserEstimatorFunction) + "(...): docs/ESTIMATORS.md\n";
     return out;

@@ -41,6 +41,9 @@ extern const std::vector<EstimatorVariant> kEstimatorVariants;
 extern const std::vector<OptionVariant> kLightSelectVariants;
 extern const std::vector<OptionVariant> kSamplerVariants;
 extern const std::vector<OptionVariant> kMisHeuristicVariants;
+// --materials: the macro is defined only when the scene has a surface that is not Lambertian
+// (GpuSceneData::microfacet), so a Lambertian scene's kernels are the course's.
+extern const std::vector<OptionVariant> kMaterialVariants;
 
 // The row named `name`; throws InputError naming `option` and the accepted names.
 const EstimatorVariant& estimator_variant(const std::string& name);

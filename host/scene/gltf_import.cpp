@@ -1,4 +1,4 @@
-// glTF 2.0 import: the default scene's triangles, Lambertian materials and perspective cameras.
+// glTF 2.0 import: the default scene's triangles, metallic-roughness materials and perspective cameras.
 //
 // tinygltf parses the file; it accepts out-of-range indices, node cycles and accessors that
 // overrun their data, so everything this file reads is validated here first. Quoted section
@@ -48,7 +48,8 @@ constexpr double kWarnCoordinate = 1e10;
 // transforms, void since textures are ignored): a file may require them ("Specifying
 // Extensions": a loader must refuse a file requiring any other).
 const std::set<std::string> kSupportedRequiredExtensions = {
-    "KHR_materials_emissive_strength", "KHR_mesh_quantization", "KHR_texture_transform"};
+    "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_mesh_quantization",
+    "KHR_texture_transform"};
 
 // ---------------------------------------------------------------------------------------------
 // Diagnostics: errors name the file and the glTF element; warnings come once per kind.
@@ -615,6 +616,9 @@ class Importer {
     uint32_t material_slot(int material_index, const std::string& referrer);
     Material convert_material(int material_index, const std::string& referrer);
     double emissive_strength(const tinygltf::Material& material, const std::string& element);
+    void read_microfacet_factors(const tinygltf::Material& source, const std::string& element,
+                                 Material& material);
+    float unit_factor(double value, const char* what, const std::string& element);
     void warn_unsupported_material_parts(const tinygltf::Material& material);
     void warn_unsupported_model_parts();
 
@@ -1046,7 +1050,13 @@ uint32_t Importer::material_slot(int material_index, const std::string& referrer
 
     Material material;
     if (material_index == -1) {
-        material.name = "default";  // "Materials": white, not emissive, single-sided
+        // "Materials": the default material is white, not emissive, single-sided, with the
+        // metallic-roughness defaults (metallic 1, roughness 1) and the specular layer of
+        // KHR_materials_specular's defaults.
+        material.name = "default";
+        material.metallic = 1.0f;
+        material.roughness = 1.0f;
+        material.specular = 1.0f;
     } else {
         material = convert_material(material_index, referrer);
     }
@@ -1099,7 +1109,59 @@ Material Importer::convert_material(int material_index, const std::string& refer
         }
     }
     material.double_sided = source.doubleSided;
+    read_microfacet_factors(source, element, material);
     return material;
+}
+
+// A factor the specification bounds to [0, 1]: NaN and infinities fail, others are clamped
+// with one warning.
+float Importer::unit_factor(double value, const char* what, const std::string& element) {
+    if (!std::isfinite(value)) diag_.fail(element, std::string(what) + " must be a finite number");
+    if (value < 0.0 || value > 1.0) {
+        diag_.warn_once(std::string("factor-") + what,
+                        element + ": " + what + " " + format_number(value) +
+                            " is outside [0, 1]; clamped");
+        value = std::clamp(value, 0.0, 1.0);
+    }
+    return float(value);
+}
+
+// glTF 2.0 Appendix B's parameters: metallicFactor, roughnessFactor (default 1 each), and
+// KHR_materials_specular's specularFactor (default 1) and specularColorFactor (default 1, 1, 1;
+// F0 = min(0.04 × it, 1) is clamped where the BRDF is built, host/render/gpu_scene.cpp).
+void Importer::read_microfacet_factors(const tinygltf::Material& source,
+                                       const std::string& element, Material& material) {
+    const auto& pbr = source.pbrMetallicRoughness;
+    material.metallic = unit_factor(pbr.metallicFactor, "metallicFactor", element);
+    material.roughness = unit_factor(pbr.roughnessFactor, "roughnessFactor", element);
+    material.specular = 1.0f;
+    material.specular_color = glm::vec3(1.0f);
+    const auto extension = source.extensions.find("KHR_materials_specular");
+    if (extension == source.extensions.end() || !extension->second.IsObject()) return;
+    const tinygltf::Value& ext = extension->second;
+    if (ext.Has("specularFactor")) {
+        const tinygltf::Value& v = ext.Get("specularFactor");
+        material.specular =
+            unit_factor(v.IsNumber() ? v.GetNumberAsDouble()
+                                     : std::numeric_limits<double>::quiet_NaN(),
+                        "KHR_materials_specular.specularFactor", element);
+    }
+    if (ext.Has("specularColorFactor")) {
+        const tinygltf::Value& v = ext.Get("specularColorFactor");
+        bool ok = v.IsArray() && v.ArrayLen() == 3;
+        glm::dvec3 c(0.0);
+        for (int k = 0; ok && k < 3; ++k) {
+            ok = v.Get(k).IsNumber();
+            if (ok) c[k] = v.Get(k).GetNumberAsDouble();
+            ok = ok && std::isfinite(c[k]) && c[k] >= 0.0 && c[k] <= 1e30;
+        }
+        if (!ok) {
+            diag_.fail(element,
+                       "KHR_materials_specular.specularColorFactor must be 3 finite "
+                       "non-negative numbers");
+        }
+        material.specular_color = glm::vec3(c);
+    }
 }
 
 // KHR_materials_emissive_strength: a non-negative multiplier of emissiveFactor, 1 when absent.
@@ -1131,7 +1193,8 @@ void Importer::warn_unsupported_material_parts(const tinygltf::Material& materia
     }
     if (material.extensions.count("KHR_materials_transmission")) {
         diag_.warn_once("transmission",
-                        "KHR_materials_transmission is not supported; surfaces are Lambertian");
+                        "KHR_materials_transmission is not supported; surfaces are opaque "
+                        "(reflection only)");
     }
 }
 

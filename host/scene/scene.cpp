@@ -30,6 +30,13 @@ glm::vec3 Scene::bounds_max() const {
     return hi;
 }
 
+void make_lambertian(std::vector<Material>& materials) {
+    for (Material& m : materials) {
+        m.metallic = 0.0f;
+        m.specular = 0.0f;
+    }
+}
+
 std::vector<EmissiveTriangle> collect_emitters(const Scene& scene) {
     std::vector<EmissiveTriangle> emitters;
     for (size_t t = 0; t < scene.triangle_count(); ++t) {

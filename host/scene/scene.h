@@ -9,13 +9,25 @@
 
 namespace mcrt {
 
-// Lambertian surface that may also emit (DESIGN.md "Radiometric contract").
+// glTF 2.0 metallic-roughness surface that may also emit (DESIGN.md "Radiometric contract").
+// Default-constructed it is the course's Lambertian reflector: the glTF importer sets the
+// specification's defaults (metallic 1, specular 1) itself.
 struct Material {
     std::string name;
     glm::vec3 albedo{1.0f};    // baseColorFactor.rgb (glTF default: white)
     glm::vec3 emission{0.0f};  // Le = emissiveFactor × KHR_materials_emissive_strength
     bool double_sided = false; // emits (and is shaded) on both faces
+    float metallic = 0.0f;     // metallicFactor, [0, 1]
+    float roughness = 1.0f;    // roughnessFactor, [0, 1]; GGX α = roughness²
+    float specular = 0.0f;     // KHR_materials_specular.specularFactor, [0, 1]; glTF default 1
+    glm::vec3 specular_color{1.0f};  // KHR_materials_specular.specularColorFactor, ≥ 0
+
+    // Exactly the Lambertian albedo/π: no metal, and no specular layer on the dielectric.
+    bool lambertian() const { return metallic == 0.0f && specular == 0.0f; }
 };
+
+// `--materials lambert`: every surface the course's Lambertian reflector of its baseColor.
+void make_lambertian(std::vector<Material>& materials);
 
 // Perspective camera; looks down its local −Z with +Y up, as glTF.
 struct Camera {
