@@ -55,25 +55,34 @@ X, Z = (1.0, 0.0, 0.0), (0.0, 0.0, 1.0)
 
 
 class StressScene(Gltf):
-    """A Gltf with helpers for Lambertian and emissive objects and a look-at camera."""
+    """A Gltf with helpers for Lambertian and emissive objects and a look-at camera. Every
+    surface says Lambertian in glTF terms: metallic 0 and KHR_materials_specular's
+    specularFactor 0 (no specular layer), so the default --materials gltf reads it as
+    baseColor/pi."""
 
     def __init__(self, name):
         super().__init__()
         self.doc["asset"]["generator"] = "mcrt scripts/make_stress_scenes.py"
-        self.doc["extensionsUsed"] = ["KHR_materials_emissive_strength"]
+        self.doc["extensionsUsed"] = ["KHR_materials_emissive_strength",
+                                      "KHR_materials_specular"]
         self.name = name
         self.roots = []
 
+    LAMBERTIAN = {"KHR_materials_specular": {"specularFactor": 0.0}}
+
     def lambertian(self, name, albedo):
         return self.material(name=name, pbrMetallicRoughness={
-            "baseColorFactor": [*albedo, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0})
+            "baseColorFactor": [*albedo, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0},
+            extensions=dict(self.LAMBERTIAN))
 
     def emitter(self, name, Le, albedo=(0.0, 0.0, 0.0), double_sided=False):
         """Le = emissiveFactor × emissiveStrength, the factor's largest component 1."""
         strength = max(Le)
         fields = {"name": name, "emissiveFactor": [round(c / strength, 6) for c in Le],
-                  "pbrMetallicRoughness": {"baseColorFactor": [*albedo, 1.0]},
-                  "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": strength}}}
+                  "pbrMetallicRoughness": {"baseColorFactor": [*albedo, 1.0],
+                                           "metallicFactor": 0.0},
+                  "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": strength},
+                                 **self.LAMBERTIAN}}
         if double_sided:
             fields["doubleSided"] = True
         return self.material(**fields)
