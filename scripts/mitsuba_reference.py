@@ -8,7 +8,15 @@ Mitsuba 3 scene and renders it:
              TRS), written as binary PLY meshes in world space (one per material), flat shaded
              (`face_normals`), so the shading normal is the geometric one, as in mcrt;
   materials  `twosided` `diffuse` with reflectance = baseColorFactor RGB (mcrt shades both faces,
-             the normal flipped toward the ray; Mitsuba's diffuse alone is one-sided);
+             the normal flipped toward the ray; Mitsuba's diffuse alone is one-sided): mcrt's
+             `--materials lambert`, which --equal-time passes to mcrt. With --materials gltf,
+             a metal (metallicFactor 1) is `twosided` `roughconductor` with material "none"
+             (Fresnel 1), specular_reflectance = baseColor, distribution ggx, alpha =
+             max(roughness^2, 1e-3), visible-normal sampling: glTF's metal exactly when
+             baseColor is 1 (Schlick with F0 = 1 is 1), up to Smith's G (Mitsuba's is
+             separable, glTF's height-correlated); a Lambertian surface (metallic 0,
+             KHR_materials_specular.specularFactor 0) stays diffuse; any other material has no
+             Mitsuba equivalent and is refused;
   emitters   `area` with radiance = emissiveFactor × KHR_materials_emissive_strength. Mitsuba's
              area emitters emit on the front side of the mesh normal, which for a PLY mesh is
              cross(p1 − p0, p2 − p0): glTF's counter-clockwise front, as mcrt. A `doubleSided`
@@ -45,6 +53,7 @@ Variant llvm_ad_rgb needs a libLLVM that Dr.Jit 1.5 can use: with Debian 12's LL
 
 Usage: mitsuba_reference.py SCENE --spp N [--width W --height H] --out X.exr
            [--variant scalar_rgb|llvm_ad_rgb] [--passes P] [--seed S] [--compare MCRT.exr]
+           [--materials lambert|gltf]
 """
 
 import argparse
@@ -215,7 +224,35 @@ def write_ply(path, triangles):
 
 # ----- the Mitsuba scene -------------------------------------------------------------------------
 
-def mitsuba_scene(mi, gltf, width, height, spp, scratch):
+def mitsuba_bsdf(material, albedo, materials):
+    """The Mitsuba BSDF of a glTF material (see "materials" above)."""
+    diffuse = {"type": "twosided", "material": {"type": "diffuse", "reflectance":
+                                                {"type": "rgb", "value": list(albedo)}}}
+    if materials == "lambert":
+        return diffuse
+    pbr = material.get("pbrMetallicRoughness", {})
+    metallic = pbr.get("metallicFactor", 1.0)
+    roughness = pbr.get("roughnessFactor", 1.0)
+    specular = material.get("extensions", {}).get("KHR_materials_specular", {}) \
+        .get("specularFactor", 1.0)
+    if metallic == 0.0 and specular == 0.0:
+        return diffuse
+    if metallic == 1.0:
+        if any(abs(c - 1.0) > 1e-6 for c in albedo):
+            print("mitsuba_reference: warning: %s: a coloured metal's Schlick Fresnel rises to 1 "
+                  "at grazing, Mitsuba's constant one does not: approximate"
+                  % material.get("name", "material"), file=sys.stderr)
+        return {"type": "twosided", "material": {
+            "type": "roughconductor", "material": "none", "distribution": "ggx",
+            "alpha": max(roughness * roughness, 1e-3), "sample_visible": True,
+            "specular_reflectance": {"type": "rgb", "value": list(albedo)}}}
+    raise mcrt_run.ScriptError(
+        "%s: metallic %g with a specular layer: glTF's dielectric (a Lambertian base under a "
+        "Schlick-weighted GGX layer) has no Mitsuba 3 equivalent; use --materials lambert"
+        % (material.get("name", "material"), metallic))
+
+
+def mitsuba_scene(mi, gltf, width, height, spp, scratch, materials="lambert"):
     triangles = gltf.triangles()
     if not triangles:
         raise ValueError("the scene has no triangles")
@@ -240,8 +277,8 @@ def mitsuba_scene(mi, gltf, width, height, spp, scratch):
     emitters = 0
     for k, (material, tri) in enumerate(sorted(triangles.items())):
         albedo, emission, double_sided = gltf.material(material)
-        bsdf = {"type": "twosided", "material": {"type": "diffuse", "reflectance":
-                                                 {"type": "rgb", "value": list(albedo)}}}
+        bsdf = mitsuba_bsdf(gltf.doc["materials"][material] if material >= 0 else {}, albedo,
+                            materials)
         copies = [(tri, "")]
         if max(emission) > 0 and double_sided:
             n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
@@ -266,7 +303,8 @@ def render(args):
     passes = max(1, min(args.passes, args.spp))
     spp_pass = args.spp // passes
     with tempfile.TemporaryDirectory(prefix="mcrt-mitsuba-") as scratch:
-        desc, emitters = mitsuba_scene(mi, gltf, args.width, args.height, spp_pass, scratch)
+        desc, emitters = mitsuba_scene(mi, gltf, args.width, args.height, spp_pass, scratch,
+                                       args.materials)
         start = time.monotonic()
         scene = mi.load_dict(desc)
         seconds_load = time.monotonic() - start
@@ -386,7 +424,8 @@ def equal_time(args, mitsuba_rgb):
         with tempfile.TemporaryDirectory(prefix="mcrt-equal-time-") as scratch:
             r = mcrt_run.render(args.scene, Path(scratch) / "m", [
                 "--width", args.width, "--height", args.height, "--spp", "16777216",
-                "--time-limit", repr(seconds), "--seed", args.seed + 17] + shlex.split(options),
+                "--time-limit", repr(seconds), "--seed", args.seed + 17,
+                "--materials", args.materials] + shlex.split(options),
                 mcrt=args.mcrt)
         result["mcrt"].append({"options": options, "spp": r.stats["spp"],
                                "seconds_render": r.stats["seconds_render"],
@@ -421,6 +460,8 @@ def main():
     p.add_argument("--passes", type=int, default=16,
                    help="passes with different seeds; their spread gives the variance layer")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--materials", choices=["lambert", "gltf"], default="lambert",
+                   help="how surfaces are converted (see materials above; default lambert)")
     p.add_argument("--compare", help="an mcrt EXR of the same size to compare with")
     p.add_argument("--diff-png", help="with --compare: write the difference image here")
     p.add_argument("--equal-time", metavar="REF.exr",

@@ -4,6 +4,7 @@
 // run through the mcrt executable, so that a regression fails the test instead of hanging it.
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstring>
@@ -294,5 +295,75 @@ TEST_CASE("silently wrong input is refused or warned about once", "[gltf][hostil
         Gltf fine;
         fine.size = 1e6;
         CHECK(load(fine).warnings.empty());
+    }
+}
+
+// ---- glTF metallic-roughness factors (DESIGN.md "Radiometric contract") ----------------------
+
+TEST_CASE("metallic-roughness factors are read, clamped with one warning, or refused",
+          "[gltf][hostile][materials]") {
+    SECTION("the specification's defaults: metallic 1, roughness 1, specular 1") {
+        Gltf g;
+        const Loaded l = load(g);
+        CHECK(l.warnings.empty());
+        const Material& m = l.scene.materials[0];
+        CHECK(m.metallic == 1.0f);
+        CHECK(m.roughness == 1.0f);
+        CHECK(m.specular == 1.0f);
+        CHECK(m.specular_color == glm::vec3(1.0f));
+        CHECK_FALSE(m.lambertian());
+    }
+    SECTION("factors and KHR_materials_specular as written; specularFactor 0 is Lambertian") {
+        Gltf g;
+        g.material = R"({"pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0.25},
+                         "extensions": {"KHR_materials_specular": {"specularFactor": 0.5,
+                                        "specularColorFactor": [1, 2, 0.5]}}})";
+        const Material m = load(g).scene.materials[0];
+        CHECK(m.metallic == 0.0f);
+        CHECK(m.roughness == 0.25f);
+        CHECK(m.specular == 0.5f);
+        CHECK(m.specular_color == glm::vec3(1.0f, 2.0f, 0.5f));
+        Gltf l;
+        l.material = R"({"pbrMetallicRoughness": {"metallicFactor": 0},
+                         "extensions": {"KHR_materials_specular": {"specularFactor": 0}}})";
+        CHECK(load(l).scene.materials[0].lambertian());
+    }
+    SECTION("the default material (a primitive without one) is the specification's") {
+        Gltf g;
+        g.material = "{}";
+        const Material m = load(g).scene.materials[0];
+        CHECK(m.metallic == 1.0f);
+        CHECK(m.roughness == 1.0f);
+    }
+    SECTION("factors outside [0, 1] are clamped with one warning each kind") {
+        Gltf g;
+        g.material = R"({"pbrMetallicRoughness": {"metallicFactor": 1.5, "roughnessFactor": -0.5},
+                         "extensions": {"KHR_materials_specular": {"specularFactor": 3}}})";
+        const Loaded l = load(g);
+        CHECK(l.warnings.size() == 3);
+        CHECK(std::count_if(l.warnings.begin(), l.warnings.end(), [](const std::string& w) {
+                  return w.find("is outside [0, 1]; clamped") != std::string::npos;
+              }) == 3);
+        const Material& m = l.scene.materials[0];
+        CHECK(m.metallic == 1.0f);
+        CHECK(m.roughness == 0.0f);
+        CHECK(m.specular == 1.0f);
+    }
+    SECTION("non-numbers and negative colours are refused") {
+        Gltf g;
+        g.material = R"({"extensions": {"KHR_materials_specular": {"specularFactor": "big"}}})";
+        CHECK(refusal(g).find("specularFactor must be a finite number") != std::string::npos);
+        Gltf c;
+        c.material = R"({"extensions": {"KHR_materials_specular": {"specularColorFactor": [1, -1, 1]}}})";
+        CHECK(refusal(c).find("specularColorFactor must be 3 finite non-negative numbers") !=
+              std::string::npos);
+        Gltf n;
+        n.material = R"({"pbrMetallicRoughness": {"metallicFactor": "1"}})";
+        CHECK(refusal(n) != "(loaded)");
+    }
+    SECTION("a file may require KHR_materials_specular") {
+        Gltf g;
+        g.extra = R"("extensionsUsed": ["KHR_materials_specular"], "extensionsRequired": ["KHR_materials_specular"],)";
+        CHECK(load(g).scene.triangle_count() == 1);
     }
 }
