@@ -38,6 +38,7 @@ user's estimator is charted against the built-in ones in one command.
 
 Usage: scripts/experiment.py SCENE --estimators a,b,... [--light-select power,...]
            [--samplers independent,...] (--spp 1,4,16,... | --seconds 0.5,1,2,...)
+           [--materials gltf|lambert]
            [--width W --height H] [--reference auto|FILE.exr] [--repeats K] --out DIR [--quick]
 """
 
@@ -78,7 +79,7 @@ def run_mcrt(args, scene, out_stem, estimator, light_select, sampler, seed, spp=
     mcrt_run.Render (rgb and variance as (3, H, W) float64, stats, wall seconds, command)."""
     options = mcrt_run.estimator_arguments(estimator) + [
         "--light-select", light_select, "--sampler", sampler, "--seed", seed,
-        "--width", args.width, "--height", args.height]
+        "--width", args.width, "--height", args.height, "--materials", args.materials]
     if args.mis_heuristic and "mis-heuristic" in mcrt_run.estimator_uses(estimator, args.mcrt):
         options += ["--mis-heuristic", args.mis_heuristic]
     if seconds is not None:
@@ -125,6 +126,7 @@ def auto_reference(args, scene, scratch):
     """Renders (or finds in the cache) the reference; returns (rgb, info dict)."""
     settings = {"estimator": "mis", "light_select": "power", "sampler": "sobol",
                 "mis_heuristic": args.mis_heuristic or "balance", "spp": args.reference_spp,
+                "materials": args.materials,
                 "width": args.width, "height": args.height, "seeds": list(REFERENCE_SEEDS)}
     key = hashlib.sha256((scene_hash(scene) + json.dumps(settings, sort_keys=True))
                          .encode()).hexdigest()[:20]
@@ -363,6 +365,8 @@ def parse_args(argv=None):
     p.add_argument("--light-select", default="power", help="comma-separated (default power)")
     p.add_argument("--samplers", default="independent", help="comma-separated (default independent)")
     p.add_argument("--mis-heuristic", help="for the estimators that use one (mcrt variants)")
+    p.add_argument("--materials", default="gltf", choices=["gltf", "lambert"],
+                   help="how mcrt reads the surfaces (default gltf; lambert: the course's model)")
     levels = p.add_mutually_exclusive_group()
     levels.add_argument("--spp", type=lambda t: number_list(t, int), help="e.g. 1,4,16,64")
     levels.add_argument("--seconds", type=lambda t: number_list(t, float),

@@ -62,6 +62,33 @@ TEST_CASE("examples/estimators/light_area.cl renders light-area's image bit for 
         }
 }
 
+TEST_CASE("examples/estimators/bsdf_directions.cl renders bsdf's image bit for bit on glossy and Lambertian surfaces",
+          "[estimator-file][cli][materials]") {
+    TempDir tmp("mcrt-estimator-file");
+    const std::string example = std::string(MCRT_EXAMPLES) + "/estimators/bsdf_directions.cl";
+    const std::string dielectric = std::string(MCRT_SCENES) + "/glossy/dielectric-plane.gltf";
+    for (const std::string& scene : {dielectric, kCornell})
+        for (const char* materials : {"gltf", "lambert"}) {
+            std::vector<std::string> common = {scene, "--width", "32", "--height", "32", "--spp",
+                                               "32", "--seed", "3", "--sampler", "sobol",
+                                               "--materials", materials, "--quiet"};
+            std::vector<std::string> builtin = {"render", "--out", tmp / "builtin.exr",
+                                                "--estimator", "bsdf"};
+            std::vector<std::string> file = {"render", "--out", tmp / "file.exr",
+                                             "--estimator-file", example};
+            builtin.insert(builtin.end(), common.begin(), common.end());
+            file.insert(file.end(), common.begin(), common.end());
+            INFO(scene << " / " << materials);
+            REQUIRE(run_mcrt(tmp, builtin).exit_code == 0);
+            REQUIRE(run_mcrt(tmp, file).exit_code == 0);
+            Image a = read_exr(tmp / "builtin.exr"), b = read_exr(tmp / "file.exr");
+            double sum = 0;
+            for (float v : a.rgb) sum += v;
+            CHECK(sum > 0);
+            CHECK(same_bits(a.rgb, b.rgb));
+        }
+}
+
 TEST_CASE("a build error in an estimator file names FILE:LINE, exits 2 and writes nothing",
           "[estimator-file][cli]") {
     TempDir tmp("mcrt-estimator-file");

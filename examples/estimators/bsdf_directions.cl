@@ -1,6 +1,7 @@
 /* The tutorial's estimator (docs/ESTIMATORS.md): directions drawn from the surface's BSDF,
- * counting the emitters they hit — on today's Lambertian surfaces the density is cosθ/π, so this
- * is `hemisphere-cosine` written with the BSDF API, and it stays right when the BSDF grows.
+ * counting the emitters they hit: `--estimator bsdf` written with the public API (it renders its
+ * image bit for bit, a test checks it). On Lambertian surfaces the density is cosθ/π, that of
+ * `hemisphere-cosine`; on glTF's glossy materials it is the lobes' mixture (docs/ESTIMATORS.md).
  *
  *     mcrt render scenes/cornell/CornellBox-Original.gltf --out a.exr \
  *         --estimator-file examples/estimators/bsdf_directions.cl
