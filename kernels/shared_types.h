@@ -135,7 +135,8 @@ typedef struct {
     float4 axis;
     uint child;    /* inner: index of the first child; leaf: index of its Light */
     uint flags;    /* LIGHT_NODE_LEAF, LIGHT_NODE_TWO_SIDED (some light below emits both ways) */
-    uint pad0, pad1;
+    float radius;  /* of the box's bounding sphere about its centre, |hi − lo|/2 rounded up */
+    float sin_o;   /* sin θ_o, rounded up: what the traversal would otherwise take a root of */
 } LightTreeNode;
 
 #define LIGHT_NODE_LEAF 1u
@@ -235,7 +236,8 @@ enum RenderArgument {
     FIELD(AliasEntry, pmf, 8)                                                                   \
     TYPE(LightTreeNode, 64, 16) FIELD(LightTreeNode, lo, 0) FIELD(LightTreeNode, hi, 16)       \
     FIELD(LightTreeNode, axis, 32) FIELD(LightTreeNode, child, 48)                              \
-    FIELD(LightTreeNode, flags, 52)                                                             \
+    FIELD(LightTreeNode, flags, 52) FIELD(LightTreeNode, radius, 56)                            \
+    FIELD(LightTreeNode, sin_o, 60)                                                             \
     TYPE(CameraGpu, 64, 16) FIELD(CameraGpu, eye, 0) FIELD(CameraGpu, right, 16)                \
     FIELD(CameraGpu, up, 32) FIELD(CameraGpu, forward, 48)                                      \
     TYPE(RenderParams, 64, 16) FIELD(RenderParams, sky, 0) FIELD(RenderParams, ao_distance, 16) \

@@ -90,6 +90,11 @@ float round_down(double x) {
     return double(f) > x ? std::nextafter(f, -2.0f) : f;
 }
 
+float round_up(double x) {
+    float f = float(x);
+    return double(f) < x ? std::nextafter(f, 2.0f * f + 1.0f) : f;
+}
+
 int ceil_log2(size_t n) {
     int k = 0;
     while ((size_t(1) << k) < n) ++k;
@@ -113,6 +118,8 @@ struct Builder {
         n.axis = {float(b.normals.w.x), float(b.normals.w.y), float(b.normals.w.z),
                   round_down(b.cos_e)};
         n.flags = b.two_sided ? LIGHT_NODE_TWO_SIDED : 0u;
+        n.radius = round_up(0.5 * glm::length(glm::dvec3(n.hi.x - n.lo.x, n.hi.y - n.lo.y, n.hi.z - n.lo.z)));
+        n.sin_o = std::min(1.0f, round_up(std::sqrt(std::max(0.0, 1.0 - double(n.hi.w) * double(n.hi.w)))));
         return n;
     }
 
