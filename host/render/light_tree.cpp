@@ -28,6 +28,10 @@ Cone whole_sphere(const glm::dvec3& w) { return Cone{w, -1.0, false}; }
 Cone cone_union(const Cone& a, const Cone& b) {
     if (a.empty) return b;
     if (b.empty) return a;
+    // Without trigonometry the common cases of the build: a holds everything, or holds b's
+    // single direction (a light's normal).
+    if (a.cos_theta <= -1.0) return a;
+    if (b.cos_theta >= 1.0 && glm::dot(a.w, b.w) >= a.cos_theta) return a;
     double theta_a = safe_acos(a.cos_theta), theta_b = safe_acos(b.cos_theta);
     double theta_d = safe_acos(glm::dot(a.w, b.w));
     if (std::min(theta_d + theta_b, kPi) <= theta_a) return a;
