@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """Writes many-light scenes for the light tree's experiments (docs/EXPERIMENTS.md, "Many lights").
 
-- lamp-field: 8192 small triangle lights (edges 0.05-0.15) scattered over a 16 x 16 field at
-  heights 1.5-3 above a floor, tilted up to 60 degrees, radiances log-spaced over 10^3 and areas
+- lamp-field: 8192 small triangle lights (edges 0.05-0.15) scattered over a 32 x 32 field at
+  heights 1-2 above a floor, tilted up to 60 degrees, radiances log-spaced over 10^3 and areas
   over 9, so powers span more than 10^4; 30% face up, away from the floor, and those are the
   brightest (x10), so selection by power spends most samples on lights that cannot light the
   floor. The camera, below the lamps, sees only the floor.
@@ -34,13 +34,13 @@ BUNNY = ROOT.parent / "shared" / "scenes" / "stanford" / "bunny_zipper.glb"
 
 def lamp_field():
     g = StressScene("lamp-field")
-    g.triangles("floor", quad((0.0, 0.0, 0.0), scale(Z, 18.0), scale(X, 18.0)),
+    g.triangles("floor", quad((0.0, 0.0, 0.0), scale(Z, 34.0), scale(X, 34.0)),
                 g.lambertian("floor", (0.6, 0.6, 0.6)))
     rng = random.Random(17)
     levels = 16
     groups = {}
     for _ in range(8192):
-        c = (rng.uniform(-8.0, 8.0), rng.uniform(1.5, 3.0), rng.uniform(-8.0, 8.0))
+        c = (rng.uniform(-16.0, 16.0), rng.uniform(1.0, 2.0), rng.uniform(-16.0, 16.0))
         up = rng.random() < 0.3
         level = rng.randrange(levels)
         # A random tilt within 60 degrees of straight down (or up).
@@ -60,8 +60,9 @@ def lamp_field():
         parts.append((points, g.emitter("lamp %s %d" % ("up" if up else "down", level),
                                         (L, 0.85 * L, 0.7 * L))))
     g.triangle_set("lamps", parts)
-    # Looking down 23 degrees with a 40 degree field of view: no ray rises, none sees a lamp.
-    g.camera((0.0, 1.3, 3.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), 40.0)
+    # Looking down 17 degrees with a 30 degree field of view from below the lamps: no ray
+    # rises, none sees a lamp.
+    g.camera((0.0, 0.9, 3.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), 30.0)
     return g.finish()
 
 

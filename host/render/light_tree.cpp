@@ -156,6 +156,7 @@ struct Builder {
     // the widest centroid axis when no bucket split exists or the path would grow too long.
     size_t split(size_t begin, size_t end, const Bounds& all, const Bounds& centroids, int depth) {
         const size_t n = end - begin;
+        if (n == 2) return begin + 1;  // the one split there is
         const bool balance = depth + ceil_log2(n) >= MCRT_LIGHT_TREE_MAX_DEPTH;
         const glm::dvec3 diagonal = all.hi - all.lo, extent = centroids.hi - centroids.lo;
         double best_cost = std::numeric_limits<double>::infinity();
