@@ -9,11 +9,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <glm/glm.hpp>
 #include <random>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "cl/cl_error.h"
 #include "cl/device.h"
@@ -44,8 +43,8 @@ void random_lights(size_t n, std::vector<gpu::Light>& lights, std::vector<double
         glm::dvec3 c(unit(rng), unit(rng), unit(rng));
         double z = 2 * unit(rng) - 1, phi = 6.283185307179586 * unit(rng), r = std::sqrt(1 - z * z);
         glm::dvec3 nrm(r * std::cos(phi), r * std::sin(phi), z);
-        glm::dvec3 a = glm::normalize(glm::cross(nrm, std::abs(nrm.x) < 0.9 ? glm::dvec3(1, 0, 0)
-                                                                           : glm::dvec3(0, 1, 0)));
+        glm::dvec3 a = glm::normalize(
+            glm::cross(nrm, std::abs(nrm.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0)));
         glm::dvec3 b = glm::cross(nrm, a);
         double size = 0.002 + 0.008 * unit(rng);
         gpu::Light l{};
@@ -89,8 +88,8 @@ int main(int argc, char** argv) {
         std::vector<DeviceInfo> devices = enumerate_devices([](const std::string&) {});
         if (devices.empty()) throw RuntimeError("no OpenCL device");
         DeviceContext d(devices.front());
-        cl::Program program = build_program(d.context, d.info.device,
-                                            kernel_source("light_select_bench.cl"), "-cl-std=CL1.2");
+        cl::Program program = build_program(
+            d.context, d.info.device, kernel_source("light_select_bench.cl"), "-cl-std=CL1.2");
         cl::Kernel kernel = make_kernel(program, "light_select_bench");
         // Shading points: the cube's points with random normals, 4096 of them.
         std::mt19937 rng(2);
@@ -98,17 +97,21 @@ int main(int argc, char** argv) {
         std::vector<gpu::float4> points, normals;
         for (int k = 0; k < 4096; ++k) {
             points.push_back(g4(glm::dvec3(unit(rng), unit(rng), unit(rng))));
-            double z = 2 * unit(rng) - 1, phi = 6.283185307179586 * unit(rng), r = std::sqrt(1 - z * z);
+            double z = 2 * unit(rng) - 1, phi = 6.283185307179586 * unit(rng),
+                   r = std::sqrt(1 - z * z);
             normals.push_back(g4(glm::dvec3(r * std::cos(phi), r * std::sin(phi), z)));
         }
         cl::Buffer p = buffer(d, points), nrm = buffer(d, normals);
         cl_int status;
-        cl::Buffer out(d.context, CL_MEM_WRITE_ONLY, size_t(choices) * sizeof(float), nullptr, &status);
+        cl::Buffer out(d.context, CL_MEM_WRITE_ONLY, size_t(choices) * sizeof(float), nullptr,
+                       &status);
         CL_CHECK_STATUS(status, "clCreateBuffer");
-        std::printf("device: %s; %u choices per method, 4096 shading points in the lights' cube\n\n",
-                    d.info.name.c_str(), choices);
-        std::printf("| lights | tree build (CPU s) | tree nodes | tree bytes/light | depth (max) | "
-                    "ns/choice uniform | CDF | alias | tree |\n|---|---|---|---|---|---|---|---|---|\n");
+        std::printf(
+            "device: %s; %u choices per method, 4096 shading points in the lights' cube\n\n",
+            d.info.name.c_str(), choices);
+        std::printf(
+            "| lights | tree build (CPU s) | tree nodes | tree bytes/light | depth (max) | "
+            "ns/choice uniform | CDF | alias | tree |\n|---|---|---|---|---|---|---|---|---|\n");
         for (size_t n : sizes) {
             std::vector<gpu::Light> lights;
             std::vector<double> powers;
@@ -124,18 +127,28 @@ int main(int argc, char** argv) {
             }
             uint32_t depth = 0;
             for (uint32_t x : tree.depth_plus_one) depth = std::max(depth, x - 1);
-            cl::Buffer cdf = buffer(d, build_cdf(powers)), alias = buffer(d, build_alias_table(powers)),
-                       nodes = buffer(d, tree.nodes);
+            cl::Buffer cdf = buffer(d, build_cdf(powers)),
+                       alias = buffer(d, build_alias_table(powers)), nodes = buffer(d, tree.nodes);
             double ns[4];
             for (cl_uint method = 0; method < 4; ++method) {
                 cl_uint index = 0;
                 auto set = [&](const auto& arg) { CL_CHECK(kernel.setArg(index++, arg)); };
-                set(method); set(cdf); set(alias); set(nodes); set(cl_uint(n)); set(cl_uint(points.size()));
-                set(p); set(nrm); set(choices); set(cl_uint(7)); set(out);
+                set(method);
+                set(cdf);
+                set(alias);
+                set(nodes);
+                set(cl_uint(n));
+                set(cl_uint(points.size()));
+                set(p);
+                set(nrm);
+                set(choices);
+                set(cl_uint(7));
+                set(out);
                 std::vector<double> times;
                 for (int r = 0; r < 6; ++r) {  // a warm-up, then the median of five
                     Clock::time_point t0 = Clock::now();
-                    CL_CHECK(d.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(choices)));
+                    CL_CHECK(
+                        d.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(choices)));
                     CL_CHECK(d.queue.finish());
                     if (r > 0) times.push_back(seconds_since(t0));
                 }

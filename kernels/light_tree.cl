@@ -65,9 +65,8 @@ inline float light_node_importance(global const LightTreeNode* node, float3 p, f
  * importance where the parent had some: they are then weighed by power alone (neither can
  * light p, so the choice only needs to be some choice), and the pmfs of all lights sum to 1
  * wherever the root has importance. False only for a non-finite importance. */
-inline bool light_tree_split(global const LightTreeNode* a, global const LightTreeNode* b,
-                             float3 p, float3 n,
-                             float* first, float* second) {
+inline bool light_tree_split(global const LightTreeNode* a, global const LightTreeNode* b, float3 p,
+                             float3 n, float* first, float* second) {
     float ia = light_node_importance(a, p, n), ib = light_node_importance(b, p, n);
     if (ia == 0.0f && ib == 0.0f) {
         ia = a->lo.w;
@@ -84,9 +83,9 @@ inline bool light_tree_split(global const LightTreeNode* a, global const LightTr
  * number (k + u_fine)·2^-24 is held as a 62-bit integer x in [0, range), range ≤ 2^62; each
  * level cuts the range at the first child's share t (the smaller share computed directly, so
  * that both keep their relative precision) and keeps the part x falls in, rescaled: the
- * stratification of u carries over as with CDF inversion, and x / range at the leaf is uniform for the point on
- * the light. pmf is the product of the children's probabilities: the chance of the choice up
- * to float rounding. pmf 0: no light can reach p (index is then meaningless). */
+ * stratification of u carries over as with CDF inversion, and x / range at the leaf is uniform for
+ * the point on the light. pmf is the product of the children's probabilities: the chance of the
+ * choice up to float rounding. pmf 0: no light can reach p (index is then meaningless). */
 inline DiscreteSample sample_light_tree(global const LightTreeNode* nodes, float3 p, float3 n,
                                         float u, float u_fine) {
     DiscreteSample s;

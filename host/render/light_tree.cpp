@@ -2,9 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
-
 #include <glm/glm.hpp>
+#include <limits>
 
 namespace mcrt {
 namespace {
@@ -122,8 +121,10 @@ struct Builder {
         n.axis = {float(b.normals.w.x), float(b.normals.w.y), float(b.normals.w.z),
                   round_down(b.cos_e)};
         n.flags = b.two_sided ? LIGHT_NODE_TWO_SIDED : 0u;
-        n.radius = round_up(0.5 * glm::length(glm::dvec3(n.hi.x - n.lo.x, n.hi.y - n.lo.y, n.hi.z - n.lo.z)));
-        n.sin_o = std::min(1.0f, round_up(std::sqrt(std::max(0.0, 1.0 - double(n.hi.w) * double(n.hi.w)))));
+        n.radius = round_up(
+            0.5 * glm::length(glm::dvec3(n.hi.x - n.lo.x, n.hi.y - n.lo.y, n.hi.z - n.lo.z)));
+        n.sin_o = std::min(
+            1.0f, round_up(std::sqrt(std::max(0.0, 1.0 - double(n.hi.w) * double(n.hi.w)))));
         return n;
     }
 
@@ -198,24 +199,25 @@ struct Builder {
             }
         }
         if (best_dim >= 0) {
-            auto it = std::partition(order.begin() + long(begin), order.begin() + long(end),
-                                     [&](uint32_t item) { return bucket_of(item, best_dim) <= best_bucket; });
+            auto it = std::partition(
+                order.begin() + long(begin), order.begin() + long(end),
+                [&](uint32_t item) { return bucket_of(item, best_dim) <= best_bucket; });
             size_t mid = size_t(it - order.begin());
             if (mid > begin && mid < end) return mid;
         }
         int dim = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
         size_t mid = begin + n / 2;
-        std::nth_element(order.begin() + long(begin), order.begin() + long(mid),
-                         order.begin() + long(end), [&](uint32_t a, uint32_t b) {
-                             return centroid[a][dim] < centroid[b][dim];
-                         });
+        std::nth_element(
+            order.begin() + long(begin), order.begin() + long(mid), order.begin() + long(end),
+            [&](uint32_t a, uint32_t b) { return centroid[a][dim] < centroid[b][dim]; });
         return mid;
     }
 };
 
 }  // namespace
 
-LightTree build_light_tree(const std::vector<gpu::Light>& lights, const std::vector<double>& powers) {
+LightTree build_light_tree(const std::vector<gpu::Light>& lights,
+                           const std::vector<double>& powers) {
     LightTree tree;
     tree.trail.assign(lights.size(), 0u);
     tree.depth_plus_one.assign(lights.size(), 0u);
@@ -224,7 +226,8 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights, const std::vec
     std::vector<uint32_t> order;
     for (size_t i = 0; i < lights.size(); ++i) {
         const gpu::Light& l = lights[i];
-        glm::dvec3 p[3] = {{l.p0.x, l.p0.y, l.p0.z}, {l.p1.x, l.p1.y, l.p1.z}, {l.p2.x, l.p2.y, l.p2.z}};
+        glm::dvec3 p[3] = {
+            {l.p0.x, l.p0.y, l.p0.z}, {l.p1.x, l.p1.y, l.p1.z}, {l.p2.x, l.p2.y, l.p2.z}};
         glm::dvec3 normal = glm::cross(p[1] - p[0], p[2] - p[0]);
         double length = glm::length(normal);
         if (!(powers[i] > 0.0)) continue;

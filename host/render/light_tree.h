@@ -23,7 +23,8 @@ struct LightTree {
 // binned (12 buckets per axis) with pbrt-v4's surface-area-orientation cost: power × the
 // orientation measure M_Ω of the cone × surface area × the box's aspect penalty. Leaves hold
 // one light; no path is longer than MCRT_LIGHT_TREE_MAX_DEPTH.
-LightTree build_light_tree(const std::vector<gpu::Light>& lights, const std::vector<double>& powers);
+LightTree build_light_tree(const std::vector<gpu::Light>& lights,
+                           const std::vector<double>& powers);
 
 // Writes each light's trail into its Le.w and p2.w bits (what the kernels' pmf twin walks).
 void store_light_trails(const LightTree& tree, std::vector<gpu::Light>& lights);
