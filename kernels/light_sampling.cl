@@ -60,7 +60,8 @@ inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint*
                                      float u_fine) {
     LightSample ls = no_light_sample();
     if (scene->lights.light_count == 0u) return ls;
-    DiscreteSample choice = select_light(&scene->lights, u.x, u_fine);
+    DiscreteSample choice = select_light(&scene->lights, sp->p, sp->n, u.x, u_fine);
+    if (!(choice.pmf > 0.0f)) return ls; /* no light can reach sp (the tree) */
     Light light = scene->lights.lights[choice.index];
     LightPoint lp = sample_light_point(&light, (float2)(choice.u_remap, u.y));
     float3 to_light = lp.p - sp->p;
@@ -92,7 +93,8 @@ inline LightSample sample_light_solid_angle(const SceneView* scene, const Surfac
                                             float2 u_light, float u_fine) {
     LightSample ls = no_light_sample();
     if (scene->lights.light_count == 0u) return ls;
-    DiscreteSample choice = select_light(&scene->lights, u_light.x, u_fine);
+    DiscreteSample choice = select_light(&scene->lights, sp->p, sp->n, u_light.x, u_fine);
+    if (!(choice.pmf > 0.0f)) return ls; /* no light can reach sp (the tree) */
     Light light = scene->lights.lights[choice.index];
     float2 u = (float2)(choice.u_remap, u_light.y); /* the rest of the sample, for the direction */
     float3 n_light = light_normal(&light);
@@ -176,7 +178,7 @@ inline float pdf_light_area(const SceneView* scene, const SurfacePoint* sp,
     Light light = scene->lights.lights[index];
     float3 d = seen->p - sp->p;
     float cos_y = fabs(dot(seen->n, wi));
-    return light_area_pdf_w(light_pmf(&scene->lights, index),
+    return light_area_pdf_w(light_pmf(&scene->lights, sp->p, sp->n, index),
                             sample_triangle_uniform_pdf_a(light_area(&light)), dot(d, d), cos_y);
 }
 
@@ -195,7 +197,7 @@ inline float pdf_light_solid_angle(const SceneView* scene, const SurfacePoint* s
     float3 a = normalize(light.p0.xyz - x), b = normalize(light.p1.xyz - x),
            c = normalize(light.p2.xyz - x);
     float omega = spherical_triangle_solid_angle(a, b, c);
-    float pmf = light_pmf(&scene->lights, index);
+    float pmf = light_pmf(&scene->lights, sp->p, sp->n, index);
     if (omega > MIN_SPHERICAL_SOLID_ANGLE && omega < MAX_SPHERICAL_SOLID_ANGLE) return pmf / omega;
     float3 d = seen->p - x;
     return pmf * pdf_area_to_solid_angle(sample_triangle_uniform_pdf_a(light_area(&light)),

@@ -3,36 +3,47 @@
 #define MCRT_LIGHTS_CL
 
 #include "discrete.cl"
+#include "light_tree.cl"
 #include "sampling.cl"
 
 /* Lights and their selection distributions: light_cdf (light_count + 1 entries) and alias
- * (light_count entries) both follow emitted power; zero-power lights are never selected. */
+ * (light_count entries) both follow emitted power; the light tree (light_tree.cl) weighs power
+ * by distance and orientation at the shading point. Zero-power lights are never selected. */
 typedef struct {
     global const Light* lights;
     global const float* light_cdf;
     global const AliasEntry* alias;
+    global const LightTreeNode* tree;
     uint light_count;
 } LightSet;
 
-/* Selects a light from u (-D LIGHT_SELECT_UNIFORM, LIGHT_SELECT_POWER or LIGHT_SELECT_ALIAS),
- * refined below the 2^-24 grid by u_fine (discrete.cl); the choice's u_remap is uniform again,
- * for the point on the light. light_count must be > 0. */
-inline DiscreteSample select_light(const LightSet* ls, float u, float u_fine) {
+/* Selects a light for the shading point p with unit normal n (the side light must arrive
+ * from) from u (-D LIGHT_SELECT_UNIFORM, LIGHT_SELECT_POWER, LIGHT_SELECT_ALIAS or
+ * LIGHT_SELECT_TREE; only the tree reads p and n), refined below the 2^-24 grid by u_fine
+ * (discrete.cl); the choice's u_remap is uniform again, for the point on the light.
+ * light_count must be > 0. pmf 0 (the tree only): no light can reach p, nothing was chosen. */
+inline DiscreteSample select_light(const LightSet* ls, float3 p, float3 n, float u,
+                                   float u_fine) {
 #if defined(LIGHT_SELECT_UNIFORM)
     return sample_discrete_uniform(ls->light_count, u, u_fine);
 #elif defined(LIGHT_SELECT_ALIAS)
     return sample_discrete_alias(ls->alias, ls->light_count, u, u_fine);
+#elif defined(LIGHT_SELECT_TREE)
+    return sample_light_tree(ls->tree, p, n, u, u_fine);
 #else
     return sample_discrete_cdf(ls->light_cdf, ls->light_count, u, u_fine);
 #endif
 }
 
-/* Probability that select_light returns light i. */
-inline float light_pmf(const LightSet* ls, uint i) {
+/* Probability that select_light at (p, n) returns light i. */
+inline float light_pmf(const LightSet* ls, float3 p, float3 n, uint i) {
 #if defined(LIGHT_SELECT_UNIFORM)
     return 1.0f / (float)ls->light_count;
 #elif defined(LIGHT_SELECT_ALIAS)
     return discrete_alias_pmf(ls->alias, i);
+#elif defined(LIGHT_SELECT_TREE)
+    global const Light* light = ls->lights + i;
+    return light_tree_pmf(ls->tree, as_uint(light->Le.w), as_uint(light->p2.w), p, n);
 #else
     return discrete_cdf_pmf(ls->light_cdf, i);
 #endif

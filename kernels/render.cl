@@ -33,7 +33,8 @@ inline float3 radiance(const SceneView* scene, const Ray* r, const SampleStream*
 kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                    global const TriangleInfo* triangle_info, global const Material* materials,
                    global const Light* lights, global const float* light_cdf,
-                   global const AliasEntry* light_alias, global const CameraGpu* camera,
+                   global const AliasEntry* light_alias, global const LightTreeNode* light_tree,
+                   global const CameraGpu* camera,
                    global float4* samples, RenderParams p) {
     size_t g = get_global_id(0);
     uint pixel = p.pixel_begin + (uint)(g / p.batch_samples);
@@ -55,6 +56,7 @@ kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* pa
     scene.lights.lights = lights;
     scene.lights.light_cdf = light_cdf;
     scene.lights.alias = light_alias;
+    scene.lights.tree = light_tree;
     scene.lights.light_count = p.light_count;
     scene.env.sky = p.sky.xyz;
     scene.env.ao_distance = p.ao_distance;

@@ -126,9 +126,35 @@ typedef struct {
 typedef struct {
     float4 p0;  /* .w area */
     float4 p1;  /* .w uint bits: flags (MATERIAL_DOUBLE_SIDED) */
-    float4 p2;  /* .w unused */
-    float4 Le;  /* .xyz emitted radiance, .w unused (selection pmfs live in the light CDF) */
+    float4 p2;  /* .w uint bits: 1 + the length of its path in the light tree; 0 not in it */
+    float4 Le;  /* .xyz emitted radiance; .w uint bits: the path, bit d set where it goes to the
+                   second child at depth d (selection pmfs live in the CDF, alias table, tree) */
 } Light;
+
+/* Node of the light tree (host/render/light_tree.h), 64 bytes: the bounds of the lights below it
+ * for the importance of kernels/light_tree.cl (Conty Estevez & Kulla 2018; pbrt-v4's
+ * LightBounds). Children of an inner node are adjacent: nodes[child], nodes[child + 1]; a leaf
+ * holds one light. nodes[0] is the root.
+ * lo.xyz / hi.xyz: box of the lights' vertices; lo.w: power φ (0 only in an empty tree).
+ * axis.xyz: unit axis w of the cone of emitting normals; hi.w: cos θ_o, its half-angle;
+ * axis.w: cos θ_e, how far beyond the normals a light emits (π/2 for area lights: 0). */
+typedef struct {
+    float4 lo;
+    float4 hi;
+    float4 axis;
+    uint child;    /* inner: index of the first child; leaf: index of its Light */
+    uint flags;    /* LIGHT_NODE_LEAF, LIGHT_NODE_TWO_SIDED (some light below emits both ways) */
+    float radius;  /* of the box's bounding sphere about its centre, |hi − lo|/2 rounded up */
+    float sin_o;   /* sin θ_o, rounded up: what the traversal would otherwise take a root of */
+} LightTreeNode;
+
+#define LIGHT_NODE_LEAF 1u
+#define LIGHT_NODE_TWO_SIDED 2u
+
+/* Longest root-to-leaf path of the light tree, in edges: a light's path is a bit trail of at
+ * most this many bits (Light.Le.w), the builder switching to median splits before a path could
+ * grow longer. */
+#define MCRT_LIGHT_TREE_MAX_DEPTH 32
 
 /* One entry of an alias table (Walker 1977; Vose 1991), 16 bytes, on the 2^-24 grid of the
  * kernels' u (kernels/discrete.cl): bucket i keeps i when its coin, an integer in [0, 2^24), is
@@ -191,6 +217,7 @@ enum RenderArgument {
     RENDER_ARG_LIGHTS,        /* global const Light* */
     RENDER_ARG_LIGHT_CDF,     /* global const float*: light_count + 1 entries */
     RENDER_ARG_LIGHT_ALIAS,   /* global const AliasEntry*: light_count entries */
+    RENDER_ARG_LIGHT_TREE,    /* global const LightTreeNode*: nodes[0] the root */
     RENDER_ARG_CAMERA,        /* global const CameraGpu* */
     RENDER_ARG_SAMPLES,       /* global float4*: out, one per work-item (radiance, rays) */
     RENDER_ARG_PARAMS,        /* RenderParams, by value */
@@ -216,6 +243,10 @@ enum RenderArgument {
     FIELD(Light, Le, 48)                                                                        \
     TYPE(AliasEntry, 16, 4) FIELD(AliasEntry, threshold, 0) FIELD(AliasEntry, alias, 4)         \
     FIELD(AliasEntry, pmf, 8)                                                                   \
+    TYPE(LightTreeNode, 64, 16) FIELD(LightTreeNode, lo, 0) FIELD(LightTreeNode, hi, 16)       \
+    FIELD(LightTreeNode, axis, 32) FIELD(LightTreeNode, child, 48)                              \
+    FIELD(LightTreeNode, flags, 52) FIELD(LightTreeNode, radius, 56)                            \
+    FIELD(LightTreeNode, sin_o, 60)                                                             \
     TYPE(CameraGpu, 64, 16) FIELD(CameraGpu, eye, 0) FIELD(CameraGpu, right, 16)                \
     FIELD(CameraGpu, up, 32) FIELD(CameraGpu, forward, 48)                                      \
     TYPE(RenderParams, 64, 16) FIELD(RenderParams, sky, 0) FIELD(RenderParams, ao_distance, 16) \

@@ -16,6 +16,7 @@
 #include "chi2.h"
 #include "device_support.h"
 #include "render/discrete.h"
+#include "render/light_tree.h"
 
 using namespace mcrt;
 using namespace mcrt::test;
@@ -26,7 +27,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 // Every χ² test of this file shares a family-wise significance of 1% (Bonferroni).
-constexpr int kChi2Tests = 14;
+constexpr int kChi2Tests = 22;
 constexpr double kAlpha = 0.01 / kChi2Tests;
 constexpr size_t kSamples = 1000000;
 
@@ -876,6 +877,271 @@ TEST_CASE("the remapped selection number is uniform within every choice (chi2)",
             CHECK(r.statistic < r.critical);
         }
     }
+}
+
+// ---- Light tree ---------------------------------------------------------------------------
+
+// Emissive triangles for the light tree's tests: small triangles of random orientation (some
+// double-sided, a fifth facing away from the origin), powers spread over 10^4, in a cube or a
+// cube; `zero_power` of them have none. n = 0 means the chain case: lights along x at 1.2^i,
+// sized in proportion, which a greedy cost peels one by one into a path longer than the limit.
+struct TreeLights {
+    std::vector<gpu::Light> lights;
+    std::vector<double> powers;
+};
+
+gpu::float4 g4(const dvec3& v, float w = 0.0f) { return {float(v.x), float(v.y), float(v.z), w}; }
+dvec3 d3(const gpu::float4& v) { return dvec3(v.x, v.y, v.z); }
+
+TreeLights tree_lights(int n, uint32_t seed, int zero_power = 0) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    auto sphere = [&] {
+        double z = 2 * unit(rng) - 1, phi = 2 * kPi * unit(rng), r = std::sqrt(1 - z * z);
+        return dvec3(r * std::cos(phi), r * std::sin(phi), z);
+    };
+    TreeLights t;
+    const bool chain = n == 0;
+    if (chain) n = 120;
+    for (int i = 0; i < n; ++i) {
+        const double scale = chain ? std::pow(1.2, i) : 1.0;
+        dvec3 c = chain ? dvec3(scale, 0, 0)
+                        : dvec3(2 * unit(rng) - 1, 2 * unit(rng) - 1, 2 * unit(rng) - 1);
+        dvec3 normal = sphere();
+        if (unit(rng) < 0.2) normal = -glm::normalize(c + dvec3(1e-9));  // faces away from 0
+        dvec3 a = glm::normalize(glm::cross(normal, std::abs(normal.x) < 0.9 ? dvec3(1, 0, 0) : dvec3(0, 1, 0)));
+        dvec3 b = glm::cross(normal, a);
+        double size = 0.05 * scale * (0.2 + unit(rng));
+        dvec3 p0 = c, p1 = c + size * a, p2 = c + size * b;  // counter-clockwise about normal
+        gpu::Light l{};
+        bool two_sided = unit(rng) < 0.25;
+        l.p0 = g4(p0, float(0.5 * size * size));
+        l.p1 = g4(p1, gpu::as_float(two_sided ? MATERIAL_DOUBLE_SIDED : 0u));
+        l.p2 = g4(p2);
+        l.Le = g4(dvec3(1.0));
+        t.lights.push_back(l);
+        t.powers.push_back(i < zero_power ? 0.0 : std::pow(10.0, 4.0 * unit(rng)));
+    }
+    return t;
+}
+
+// Shading points of the tests: positions in a cube a little larger than the lights', normals
+// uniform on the sphere.
+void tree_points(size_t count, uint32_t seed, std::vector<cl_float4>& p, std::vector<cl_float4>& n) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (size_t k = 0; k < count; ++k) {
+        p.push_back(f4(dvec3(3 * unit(rng) - 1.5, 3 * unit(rng) - 1.5, 3 * unit(rng) - 1.5)));
+        double z = 2 * unit(rng) - 1, phi = 2 * kPi * unit(rng), r = std::sqrt(1 - z * z);
+        n.push_back(f4(dvec3(r * std::cos(phi), r * std::sin(phi), z)));
+    }
+}
+
+struct TreeCase {
+    int n;
+    int zero_power;
+};
+const std::vector<TreeCase> kTreeCases = {{1, 0}, {2, 0}, {5, 1}, {64, 3}, {1000, 10}, {0, 0}};
+
+TEST_CASE("light tree: every light in one leaf, bounds hold their children", "[sampling][light-tree]") {
+    for (const TreeCase& c : kTreeCases) {
+        INFO("lights " << c.n);
+        TreeLights t = tree_lights(c.n, 7u + uint32_t(c.n), c.zero_power);
+        LightTree tree = build_light_tree(t.lights, t.powers);
+        const size_t in_tree = t.lights.size() - size_t(c.zero_power);
+        REQUIRE(tree.nodes.size() == 2 * in_tree - 1);
+        std::vector<int> leaf_of(t.lights.size(), 0);
+        size_t max_depth = 0;
+        for (size_t i = 0; i < t.lights.size(); ++i) {
+            if (t.powers[i] == 0) {
+                CHECK(tree.depth_plus_one[i] == 0);
+                continue;
+            }
+            REQUIRE(tree.depth_plus_one[i] >= 1);
+            const size_t depth = tree.depth_plus_one[i] - 1;
+            max_depth = std::max(max_depth, depth);
+            REQUIRE(depth <= MCRT_LIGHT_TREE_MAX_DEPTH);
+            // Down the trail: every node on it bounds the light (box, normal cone, power).
+            const gpu::Light& l = t.lights[i];
+            dvec3 p0 = d3(l.p0), p1 = d3(l.p1), p2 = d3(l.p2);
+            dvec3 normal = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+            uint32_t node = 0;
+            for (size_t d = 0; d <= depth; ++d) {
+                const gpu::LightTreeNode& x = tree.nodes[node];
+                for (const dvec3& v : {p0, p1, p2})
+                    for (int a = 0; a < 3; ++a) {
+                        CHECK(v[a] >= (&x.lo.x)[a]);
+                        CHECK(v[a] <= (&x.hi.x)[a]);
+                    }
+                dvec3 axis(x.axis.x, x.axis.y, x.axis.z);
+                CHECK(glm::dot(axis, normal) >= double(x.hi.w) - 1e-6);
+                CHECK(double(x.lo.w) >= 0.999 * t.powers[i]);
+                if (d == depth) {
+                    CHECK((x.flags & LIGHT_NODE_LEAF) != 0);
+                    CHECK(x.child == i);
+                    leaf_of[i] += 1;
+                } else {
+                    REQUIRE((x.flags & LIGHT_NODE_LEAF) == 0);
+                    node = x.child + ((tree.trail[i] >> d) & 1u);
+                }
+            }
+        }
+        for (size_t i = 0; i < t.lights.size(); ++i) CHECK(leaf_of[i] == (t.powers[i] > 0 ? 1 : 0));
+        // The root's power is the sum of all.
+        CHECK(double(tree.nodes[0].lo.w) ==
+              Approx(std::accumulate(t.powers.begin(), t.powers.end(), 0.0)).epsilon(1e-5));
+        if (c.n == 0) CHECK(max_depth <= MCRT_LIGHT_TREE_MAX_DEPTH);  // the chain hit the limit
+        std::printf("light tree of %zu lights: %zu nodes, depth %zu\n", in_tree, tree.nodes.size(),
+                    max_depth);
+    }
+}
+
+// The tree's lights and shading points on the device.
+struct TreeOnDevice {
+    TreeLights t;
+    cl_uint n;
+    cl::Buffer nodes, lights, p, normal;
+    std::vector<cl_float4> points, normals;
+    TreeOnDevice(Device& d, const TreeCase& c, size_t point_count) : t(tree_lights(c.n, 11u + uint32_t(c.n), c.zero_power)) {
+        LightTree tree = build_light_tree(t.lights, t.powers);
+        store_light_trails(tree, t.lights);
+        n = cl_uint(t.lights.size());
+        tree_points(point_count, 3u + uint32_t(c.n), points, normals);
+        nodes = d.buffer(tree.nodes);
+        lights = d.buffer(t.lights);
+        p = d.buffer(points);
+        normal = d.buffer(normals);
+    }
+};
+
+TEST_CASE("light tree: pmfs sum to 1 at every point, the sampler reports the twin's pmf",
+          "[sampling][light-tree]") {
+    // Enumeration: the twin's pmf of every light at a point sums to one (or to zero where no
+    // light can reach the point: the sampler then finds none, and the geometry agrees that no
+    // light shows an emitting face above the point's horizon), and each sample's pmf is bit
+    // for bit the twin's of the light it chose.
+    Device& d = device();
+    constexpr size_t kPoints = 64, kPerPoint = 4096;
+    for (const TreeCase& c : kTreeCases) {
+        TreeOnDevice tree(d, c, kPoints);
+        INFO("lights " << tree.n);
+        cl::Buffer pmf = d.output<float>(tree.n * kPoints);
+        d.run("light_tree_pmfs", tree.n * kPoints, tree.nodes, tree.lights, tree.n, cl_uint(kPoints),
+              tree.p, tree.normal, pmf);
+        std::vector<float> pmfs = d.read<float>(pmf, tree.n * kPoints);
+        cl::Buffer out = d.output<cl_uint4>(kPoints * kPerPoint);
+        d.run("sample_light_tree_at", kPoints * kPerPoint, tree.nodes, tree.lights,
+              cl_uint(kPoints), cl_uint(kPerPoint), 0u, 5u, tree.p, tree.normal, out);
+        std::vector<cl_uint4> s = d.read<cl_uint4>(out, kPoints * kPerPoint);
+        size_t reachable = 0, wrong_twin = 0, zero_chosen = 0, out_of_range = 0, none_chosen = 0;
+        for (size_t k = 0; k < kPoints; ++k) {
+            double sum = 0;
+            for (size_t i = 0; i < tree.n; ++i) sum += pmfs[k * tree.n + i];
+            if (sum != 0) {
+                ++reachable;
+                CHECK(sum == Approx(1.0).epsilon(1e-5));
+            } else {
+                const dvec3 p = d3(tree.points[k]), n = d3(tree.normals[k]);
+                for (size_t i = 0; i < tree.n; ++i) {
+                    const gpu::Light& l = tree.t.lights[i];
+                    dvec3 v[3] = {d3(l.p0), d3(l.p1), d3(l.p2)};
+                    dvec3 ln = glm::normalize(glm::cross(v[1] - v[0], v[2] - v[0]));
+                    bool two_sided = (gpu::as_uint(l.p1.w) & MATERIAL_DOUBLE_SIDED) != 0;
+                    bool above = false;
+                    for (const dvec3& y : v) above = above || glm::dot(n, y - p) > 1e-6;
+                    bool facing = two_sided || glm::dot(ln, p - v[0]) > -1e-6;
+                    INFO("point " << k << " light " << i);
+                    CHECK(!(above && facing && tree.t.powers[i] > 0));
+                }
+            }
+            for (size_t j = k * kPerPoint; j < (k + 1) * kPerPoint; ++j) {
+                float reported, twin;
+                std::memcpy(&reported, &s[j].s[1], sizeof reported);
+                std::memcpy(&twin, &s[j].s[3], sizeof twin);
+                if (reported == 0.0f) {
+                    none_chosen += sum != 0 ? 1 : 0;
+                    continue;
+                }
+                if (s[j].s[0] >= tree.n) {
+                    ++out_of_range;
+                    continue;
+                }
+                if (reported != twin || reported != pmfs[k * tree.n + s[j].s[0]]) ++wrong_twin;
+                if (tree.t.powers[s[j].s[0]] == 0) ++zero_chosen;
+            }
+        }
+        CHECK(reachable > kPoints / 4);
+        CHECK(none_chosen == 0);
+        CHECK(out_of_range == 0);
+        CHECK(wrong_twin == 0);
+        CHECK(zero_chosen == 0);
+    }
+}
+
+TEST_CASE("light tree: selection frequencies match the pmf (chi2), stratified u stays stratified, "
+          "u_remap is uniform (chi2)",
+          "[sampling][light-tree]") {
+    Device& d = device();
+    constexpr int kBins = 16;
+    int tested = 0;
+    for (const TreeCase& c : kTreeCases) {
+        if (c.n < 2) continue;
+        TreeOnDevice tree(d, c, 8);
+        cl::Buffer pmf = d.output<float>(tree.n * 8);
+        d.run("light_tree_pmfs", tree.n * 8, tree.nodes, tree.lights, tree.n, cl_uint(8), tree.p,
+              tree.normal, pmf);
+        std::vector<float> pmfs = d.read<float>(pmf, tree.n * 8);
+        // The first point that some light reaches.
+        size_t k = 0;
+        while (k < 8 && std::accumulate(pmfs.begin() + long(k * tree.n),
+                                        pmfs.begin() + long((k + 1) * tree.n), 0.0) == 0)
+            ++k;
+        REQUIRE(k < 8);
+        std::vector<cl_float4> one_p{tree.points[k]}, one_n{tree.normals[k]};
+        cl::Buffer p1 = d.buffer(one_p), n1 = d.buffer(one_n);
+        cl::Buffer out = d.output<cl_uint4>(kSamples);
+        const std::string name = "light tree " + std::to_string(tree.n);
+        for (cl_uint stratified : {0u, 1u}) {
+            d.run("sample_light_tree_at", kSamples, tree.nodes, tree.lights, 1u, cl_uint(kSamples),
+                  stratified, 9u, p1, n1, out);
+            std::vector<cl_uint4> s = d.read<cl_uint4>(out, kSamples);
+            std::vector<double> observed(tree.n, 0.0), expected(tree.n);
+            std::vector<double> remap(size_t(tree.n) * kBins, 0.0), remap_expected(remap.size());
+            size_t outside = 0;
+            for (const cl_uint4& x : s) {
+                float r, reported;
+                std::memcpy(&r, &x.s[2], sizeof r);
+                std::memcpy(&reported, &x.s[1], sizeof reported);
+                if (x.s[0] >= tree.n || !(r >= 0.0f && r < 1.0f) || !(reported > 0.0f)) {
+                    ++outside;
+                    continue;
+                }
+                observed[x.s[0]] += 1;
+                remap[size_t(x.s[0]) * kBins + size_t(r * kBins)] += 1;
+            }
+            CHECK(outside == 0);
+            for (size_t i = 0; i < tree.n; ++i) expected[i] = kSamples * double(pmfs[k * tree.n + i]);
+            for (size_t b = 0; b < remap.size(); ++b) remap_expected[b] = observed[b / kBins] / kBins;
+            if (stratified == 0) {
+                Chi2 r = chi2_test(name + " frequencies", observed, expected);
+                CHECK(r.statistic < r.critical);
+                r = chi2_test(name + " remap", remap, remap_expected);
+                CHECK(r.statistic < r.critical);
+                tested += 2;
+            } else {
+                // Evenly spaced u: the choice inverts a CDF laid out in tree order, so each
+                // light is chosen pmf·N times to within one at each end of its interval (u is
+                // read on the 2^-24 grid), plus the pmf's float rounding: far tighter than the
+                // ±sqrt(pmf·N) of independent samples.
+                double worst = 0;
+                for (size_t i = 0; i < tree.n; ++i)
+                    worst = std::max(worst, std::abs(observed[i] - expected[i]) / (2.0 + 1e-5 * expected[i]));
+                INFO(name << ": worst |count - pmf N| / (2 + 1e-5 pmf N) " << worst);
+                CHECK(worst <= 1.0);
+            }
+        }
+    }
+    CHECK(tested == 8);
 }
 
 // ---- Frames -------------------------------------------------------------------------------

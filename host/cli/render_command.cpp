@@ -234,7 +234,8 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     }
 
     Bvh bvh = build_bvh(scene);
-    GpuSceneData gpu_scene = make_gpu_scene(scene, bvh, camera, o.width, o.height);
+    GpuSceneData gpu_scene = make_gpu_scene(scene, bvh, camera, o.width, o.height,
+                                            light_select_uses_tree(settings.light_select));
 
     RenderControl control;
     control.time_limit = o.time_limit;

@@ -23,6 +23,7 @@
 #include "mpi/remote_worker.h"
 #include "mpi/wire.h"
 #include "render/device_worker.h"
+#include "render/variants.h"
 
 namespace mcrt {
 namespace {
@@ -254,7 +255,8 @@ int serve_render(const RenderOptions& o) {
         const Camera camera = render_camera(scene, o);
         const std::vector<DeviceInfo> devices = select_devices(o.devices, warn);
         Bvh bvh = build_bvh(scene);
-        gpu_scene = make_gpu_scene(scene, bvh, camera, o.width, o.height);
+        gpu_scene = make_gpu_scene(scene, bvh, camera, o.width, o.height,
+                                   light_select_uses_tree(settings.light_select));
         const uint64_t fixed_batch =
             settings.batch > 0 ? uint64_t(settings.width) * settings.height *
                                      batch_samples_per_pixel(settings.batch, settings.width,

@@ -60,6 +60,7 @@ void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene,
     CL_CHECK(render.setArg(gpu::RENDER_ARG_LIGHTS, scene.lights));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_LIGHT_CDF, scene.light_cdf));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_LIGHT_ALIAS, scene.light_alias));
+    CL_CHECK(render.setArg(gpu::RENDER_ARG_LIGHT_TREE, scene.light_tree));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_CAMERA, scene.camera));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_SAMPLES, samples));
 }

@@ -6,6 +6,7 @@
 
 #include "cl/cl_error.h"
 #include "render/discrete.h"
+#include "render/light_tree.h"
 
 namespace mcrt {
 
@@ -25,7 +26,7 @@ gpu::CameraGpu make_gpu_camera(const Camera& camera, int width, int height) {
 }
 
 GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& camera, int width,
-                            int height) {
+                            int height, bool light_tree) {
     GpuSceneData data;
     data.nodes = bvh.nodes4;
     data.packets = bvh.packets;
@@ -63,6 +64,11 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
     }
     data.light_cdf = build_cdf(powers);
     data.light_alias = build_alias_table(powers);
+    if (light_tree) {
+        LightTree tree = build_light_tree(data.lights, powers);
+        store_light_trails(tree, data.lights);
+        data.light_tree = std::move(tree.nodes);
+    }
     // Shading's view of each packet lane (unused lanes stay zero: no ray hits them).
     data.triangle_info.assign(bvh.packets.size() * MCRT_PACKET_WIDTH, gpu::TriangleInfo{});
     for (size_t p = 0; p < bvh.packets.size(); ++p) {
@@ -105,6 +111,7 @@ GpuSceneBuffers::GpuSceneBuffers(const DeviceContext& device, const GpuSceneData
     lights = upload(device, data.lights, bytes, "lights");
     light_cdf = upload(device, data.light_cdf, bytes, "light CDF");
     light_alias = upload(device, data.light_alias, bytes, "light alias table");
+    light_tree = upload(device, data.light_tree, bytes, "light tree");
     camera = upload(device, std::vector<gpu::CameraGpu>{data.camera}, bytes, "camera");
     light_count = cl_uint(data.lights.size());
 }

@@ -22,6 +22,7 @@ struct GpuSceneData {
     std::vector<gpu::Light> lights;
     std::vector<float> light_cdf;  // lights + 1 entries, by power (PBRT 3rd ed. 13.3.1)
     std::vector<gpu::AliasEntry> light_alias;  // the same distribution as an alias table
+    std::vector<gpu::LightTreeNode> light_tree;  // --light-select tree (render/light_tree.h)
     gpu::CameraGpu camera{};
     // Some surface is not Lambertian: the kernels need the microfacet BRDF (-D
     // MCRT_MATERIALS_GLTF); a Lambertian scene's kernels are built without it.
@@ -31,14 +32,17 @@ struct GpuSceneData {
 // The camera of DESIGN.md's camera contract for an image of width × height.
 gpu::CameraGpu make_gpu_camera(const Camera& camera, int width, int height);
 
-// Flattens the scene, its BVH and its emitters; `camera` as chosen by the caller.
+// Flattens the scene, its BVH and its emitters; `camera` as chosen by the caller. The light
+// tree is built only with `light_tree` (the other selections never read it: it costs about
+// 128 bytes per light).
 GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& camera, int width,
-                            int height);
+                            int height, bool light_tree = true);
 
 // Device copies of GpuSceneData (empty arrays get a one-element buffer, never a null one).
 struct GpuSceneBuffers {
     GpuSceneBuffers(const DeviceContext& device, const GpuSceneData& data);
-    cl::Buffer nodes, packets, triangle_info, materials, lights, light_cdf, light_alias, camera;
+    cl::Buffer nodes, packets, triangle_info, materials, lights, light_cdf, light_alias, light_tree,
+        camera;
     cl_uint light_count = 0;
     size_t bytes = 0;
 };

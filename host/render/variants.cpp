@@ -38,6 +38,9 @@ const std::vector<OptionVariant> kLightSelectVariants = {
      "in proportion to emitted power, CDF inversion by binary search (PBRT 13.3.1), on the 2^-24 "
      "grid"},
     {"alias", "LIGHT_SELECT_ALIAS", "the power distribution by an alias table (Vose 1991), O(1)"},
+    {"tree", "LIGHT_SELECT_TREE",
+     "a light tree (SAOH-built BVH with orientation cones): power x distance x orientation at the "
+     "shading point (Conty Estevez & Kulla 2018; pbrt-v4 BVHLightSampler)"},
 };
 
 const std::vector<OptionVariant> kSamplerVariants = {
@@ -71,6 +74,8 @@ std::string accepted(const std::vector<Row>& table) {
 }
 
 }  // namespace
+
+bool light_select_uses_tree(const std::string& name) { return name == "tree"; }
 
 const EstimatorVariant& estimator_variant(const std::string& name) {
     for (const EstimatorVariant& row : kEstimatorVariants)

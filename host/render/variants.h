@@ -50,6 +50,9 @@ const EstimatorVariant& estimator_variant(const std::string& name);
 const OptionVariant& option_variant(const std::vector<OptionVariant>& table,
                                     const std::string& name, const char* option);
 
+// True for the light selection that reads the light tree (make_gpu_scene builds it only then).
+bool light_select_uses_tree(const std::string& name);
+
 // The rows' names, in table order (CLI11's IsMember, --help, the tests).
 std::vector<std::string> variant_names(const std::vector<EstimatorVariant>& table);
 std::vector<std::string> variant_names(const std::vector<OptionVariant>& table);

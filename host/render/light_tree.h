@@ -1,0 +1,32 @@
+// The light tree of --light-select tree: a bounding hierarchy over the emissive triangles whose
+// nodes carry power, a box and a cone of emitting normals, so that the kernels can choose a
+// light in proportion to an importance that depends on the shading point (kernels/light_tree.cl;
+// Conty Estevez & Kulla 2018, "Importance Sampling of Many Lights with Adaptive Tree Splitting";
+// pbrt-v4's BVHLightSampler).
+#pragma once
+
+#include <vector>
+
+#include "shared_types.h"
+
+namespace mcrt {
+
+struct LightTree {
+    std::vector<gpu::LightTreeNode> nodes;  // nodes[0] the root; empty when no light has power
+    // Per light: its path from the root (bit d set: second child at depth d) and the path's
+    // length plus one, 0 for a light outside the tree (zero power), as Light.Le.w and .p2.w hold.
+    std::vector<uint32_t> trail, depth_plus_one;
+};
+
+// Builds the tree over `lights` (vertices and MATERIAL_DOUBLE_SIDED from gpu::Light) weighted by
+// `powers` (one per light, >= 0; zero-power lights are left out and never chosen). Top-down,
+// binned (12 buckets per axis) with pbrt-v4's surface-area-orientation cost: power × the
+// orientation measure M_Ω of the cone × surface area × the box's aspect penalty. Leaves hold
+// one light; no path is longer than MCRT_LIGHT_TREE_MAX_DEPTH.
+LightTree build_light_tree(const std::vector<gpu::Light>& lights,
+                           const std::vector<double>& powers);
+
+// Writes each light's trail into its Le.w and p2.w bits (what the kernels' pmf twin walks).
+void store_light_trails(const LightTree& tree, std::vector<gpu::Light>& lights);
+
+}  // namespace mcrt
