@@ -5,10 +5,13 @@
 #include "bvh_traverse.cl"
 #include "lights.cl"
 
-/* The uniform environment of the ambient estimators (DESIGN.md "Radiometric contract"). */
+/* The uniform environment (DESIGN.md "Radiometric contract"): the ambient estimators' sky, or,
+ * with --sky and a direct or path estimator, a light at infinity beside the area lights. */
 typedef struct {
     float3 sky;        /* radiance of the uniform sky */
     float ao_distance; /* occlusion range; 0 = unbounded */
+    float sky_pmf;     /* probability that the light strategies choose the sky light; 0: the sky
+                          is no light (light_sampling.cl) */
 } Environment;
 
 typedef struct {
@@ -53,6 +56,11 @@ inline SurfacePoint surface_point(const SceneView* scene, const Ray* r, const Hi
 inline float3 emitted_radiance(const SurfacePoint* sp) {
     bool emits = sp->front || (sp->material.flags & MATERIAL_DOUBLE_SIDED) != 0u;
     return emits ? sp->material.Le.xyz : (float3)(0.0f);
+}
+
+/* Radiance that a ray leaving the scene sees: the sky when it is a light, else black. */
+inline float3 environment_radiance(const SceneView* scene) {
+    return scene->env.sky_pmf > 0.0f ? scene->env.sky : (float3)(0.0f);
 }
 
 /* True if nothing blocks the segment between the offset origins of a and b; na and nb are the
