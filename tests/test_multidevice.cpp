@@ -98,7 +98,7 @@ TEST_CASE("two devices render the image of one device, bit for bit, both doing w
     CHECK(fixed.replicates == replicates);
 }
 
-TEST_CASE("paths of depth 8 render bit for bit alike on one device, two, and any batch",
+TEST_CASE("paths of depth 8 render bit for bit alike on one device or two and in any batch",
           "[multidevice][paths]") {
     Devices devices;
     Scene scene = load_gltf(kCornell, [](const std::string&) {});
