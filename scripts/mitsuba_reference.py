@@ -228,7 +228,7 @@ def integrator(max_depth, rr_depth):
             "hide_emitters": False}
 
 
-def mitsuba_scene(mi, gltf, width, height, spp, scratch, max_depth=1, rr_depth=5):
+def mitsuba_scene(mi, gltf, width, height, spp, scratch, max_depth=1, rr_depth=5, sky=None):
     triangles = gltf.triangles()
     if not triangles:
         raise ValueError("the scene has no triangles")
@@ -251,6 +251,9 @@ def mitsuba_scene(mi, gltf, width, height, spp, scratch, max_depth=1, rr_depth=5
         },
     }
     emitters = 0
+    if sky:  # mcrt's --sky with a direct or path estimator: a uniform light at infinity
+        scene["sky"] = {"type": "constant", "radiance": {"type": "rgb", "value": list(sky)}}
+        emitters += 1
     for k, (material, tri) in enumerate(sorted(triangles.items())):
         albedo, emission, double_sided = gltf.material(material)
         bsdf = {"type": "twosided", "material": {"type": "diffuse", "reflectance":
@@ -283,7 +286,7 @@ def render(args):
     spp_pass = args.spp // passes
     with tempfile.TemporaryDirectory(prefix="mcrt-mitsuba-") as scratch:
         desc, emitters = mitsuba_scene(mi, gltf, args.width, args.height, spp_pass, scratch,
-                                       args.max_depth, args.rr_depth)
+                                       args.max_depth, args.rr_depth, args.sky)
         start = time.monotonic()
         scene = mi.load_dict(desc)
         seconds_load = time.monotonic() - start
@@ -444,6 +447,8 @@ def main():
                    help="reflections, as mcrt's --max-depth: 1 is `direct`, N > 1 `path` with "
                    "max_depth N + 1")
     p.add_argument("--rr-depth", type=int, default=5, help="with --max-depth > 1: `path`'s rr_depth")
+    p.add_argument("--sky", type=lambda t: [float(x) for x in (t.split(",") * 3)[:3]],
+                   help="R,G,B (or one value): a `constant` emitter, as mcrt's --sky light")
     p.add_argument("--compare", help="an mcrt EXR of the same size to compare with")
     p.add_argument("--diff-png", help="with --compare: write the difference image here")
     p.add_argument("--equal-time", metavar="REF.exr",

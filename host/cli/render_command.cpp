@@ -229,8 +229,9 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     if (scene.triangle_count() == 0) print_warning(o.scene + ": the scene has no triangles");
     unsigned uses =
         o.estimator_file.empty() ? estimator_variant(o.estimator).uses : kUserEstimatorUses;
-    if ((uses & kUsesLights) && collect_emitters(scene).empty())
-        print_warning(o.scene + ": no emissive triangles: direct lighting is black");
+    if ((uses & kUsesLights) && !settings.sky_light && collect_emitters(scene).empty())
+        print_warning(o.scene + ": no emissive triangles: direct lighting is black" +
+                      (uses & kUsesSkyLight ? " (--sky R,G,B adds a sky light)" : ""));
     Camera camera = render_camera(scene, o);
     if (job) {
         job->share_inputs(files, settings.estimator_source);
