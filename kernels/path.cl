@@ -17,6 +17,14 @@
 
 inline float max_component(float3 v) { return fmax(v.x, fmax(v.y, v.z)); }
 
+/* True when the memo holds the ray from sp along wi, bit for bit: the estimator traced the
+ * continuation already (its BSDF or cosine direction from the same numbers). */
+inline bool memo_holds(const TraceMemo* memo, const SurfacePoint* sp, float3 wi) {
+    float3 o = offset_ray_origin(sp->p, sp->n);
+    return memo->valid && all(as_uint3(memo->origin) == as_uint3(o)) &&
+           all(as_uint3(memo->wi) == as_uint3(wi));
+}
+
 /* What a path did, for the stats: surface vertices it reached, and whether roulette ended it. */
 typedef struct {
     uint rays;
@@ -29,10 +37,11 @@ typedef struct {
  * reflected there directly (its own strategies; emitters that the continuation later finds are
  * not counted again). The continuation samples the BSDF with the vertex's DIM_DIRECTION numbers,
  * the ones the BSDF and MIS estimators use, so that their direction is also the path's (as
- * pbrt's path tracer shares it). A ray leaving the scene sees black, or the sky for the ambient
+ * pbrt's path tracer shares it) and its ray is traced once (TraceMemo). A ray leaving the scene sees black, or the sky for the ambient
  * estimators (-D ESTIMATOR_USES_SKY) and the sky light (DESIGN.md "Radiometric contract"). */
 inline float3 path_radiance(const SceneView* scene, const Ray* r, SampleStream* stream,
                             uint max_depth, uint rr_depth, PathRecord* record) {
+    TraceMemo* memo = scene->memo; /* may be 0 (direct lighting keeps none) */
     record->rays += 1u;
     Hit hit = bvh_closest_hit(scene->nodes, scene->packets, r, MAXFLOAT);
 #if defined(ESTIMATOR_USES_SKY)
@@ -47,6 +56,7 @@ inline float3 path_radiance(const SceneView* scene, const Ray* r, SampleStream* 
     for (uint k = 0u; k < max_depth;) {
         /* Direct light at vertex k, by the estimator's strategies. */
         stream->vertex = k;
+        if (memo) memo->valid = false;
         L += beta * MCRT_ESTIMATE(scene, &sp, stream, &record->rays);
         if (++k == max_depth) break;
 
@@ -68,7 +78,12 @@ inline float3 path_radiance(const SceneView* scene, const Ray* r, SampleStream* 
         }
 
         SurfacePoint next;
-        if (!trace_from(scene, &sp, bs.wi, &record->rays, &next)) break;
+        if (memo && memo_holds(memo, &sp, bs.wi)) {
+            if (!memo->hit) break;
+            next = memo->seen;
+        } else if (!trace_from(scene, &sp, bs.wi, &record->rays, &next)) {
+            break;
+        }
         sp = next;
         record->vertices += 1u;
     }

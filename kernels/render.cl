@@ -40,6 +40,9 @@ kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* pa
     scene.env.sky = p.sky.xyz;
     scene.env.ao_distance = p.ao_distance;
     scene.env.sky_pmf = p.sky.w;
+    TraceMemo memo;
+    memo.valid = false;
+    scene.memo = p.max_depth > 1u ? &memo : 0; /* direct lighting has no continuation */
 
     float3 dir = camera_direction(camera, pixel % p.width, pixel / p.width,
                                   sample_2d(&stream, DIM_PIXEL_JITTER), p.width, p.height);
