@@ -47,7 +47,8 @@ def main():
         with tempfile.TemporaryDirectory(prefix="mcrt-bench-paths-") as scratch:
             r = mcrt_run.render(scene, Path(scratch) / "m", [
                 "--width", args.width, "--height", args.height, "--spp", args.spp,
-                "--max-depth", args.depth, "--estimator", "mis"] + sky, mcrt=args.mcrt)
+                "--max-depth", args.depth, "--estimator", "mis"] + sky, mcrt=args.mcrt,
+                read_image=False)
             exr = Path(scratch) / "mitsuba.exr"
             subprocess.run([sys.executable, str(ROOT / "scripts" / "mitsuba_reference.py"), scene,
                             "--spp", str(args.spp * args.passes), "--passes", str(args.passes),
