@@ -116,8 +116,8 @@ inline float3 estimate_mis(const SceneView* scene, const SurfacePoint* sp,
             }
         } else if (scene->env.sky_pmf > 0.0f) {
             float pdf_light = pdf_light_sky(scene, sp, bs.wi);
-            L += bs.f * scene->env.sky *
-                 (bs.cos_theta / bs.pdf_w * mis_weight(bs.pdf_w, pdf_light));
+            L +=
+                bs.f * scene->env.sky * (bs.cos_theta / bs.pdf_w * mis_weight(bs.pdf_w, pdf_light));
         }
     }
     return L;

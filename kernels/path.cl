@@ -37,8 +37,9 @@ typedef struct {
  * reflected there directly (its own strategies; emitters that the continuation later finds are
  * not counted again). The continuation samples the BSDF with the vertex's DIM_DIRECTION numbers,
  * the ones the BSDF and MIS estimators use, so that their direction is also the path's (as
- * pbrt's path tracer shares it) and its ray is traced once (TraceMemo). A ray leaving the scene sees black, or the sky for the ambient
- * estimators (-D ESTIMATOR_USES_SKY) and the sky light (DESIGN.md "Radiometric contract"). */
+ * pbrt's path tracer shares it) and its ray is traced once (TraceMemo). A ray leaving the scene
+ * sees black, or the sky for the ambient estimators (-D ESTIMATOR_USES_SKY) and the sky light
+ * (DESIGN.md "Radiometric contract"). */
 inline float3 path_radiance(const SceneView* scene, const Ray* r, SampleStream* stream,
                             uint max_depth, uint rr_depth, PathRecord* record) {
     TraceMemo* memo = scene->memo; /* may be 0 (direct lighting keeps none) */

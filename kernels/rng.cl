@@ -47,15 +47,15 @@ inline uint replicate_seed(const SampleStream* s) { return s->seed ^ (s->replica
  * They are the dimensions of one path vertex: vertex k of a path (k reflections after the
  * camera's hit) reads dimension d as stream_dimension() maps it, so that each vertex has its
  * own numbers and an estimator is written once for every vertex. */
+/* DIM_ROULETTE, at vertices k >= 1 only (the jitter's slot): Russian roulette before the path
+ * reaches vertex k (path.cl). The path goes on by bsdf_sample of DIM_DIRECTION's numbers. */
 #define DIM_PIXEL_JITTER 0u   /* 2D, vertex 0 only: the point in the pixel */
-#define DIM_ROULETTE 0u       /* 1D, vertices k >= 1 (the slot of the jitter): Russian roulette
-                                 before the path reaches vertex k (path.cl) */
+#define DIM_ROULETTE 0u       /* 1D, vertices k >= 1 */
 #define DIM_LIGHT_FINE 2u     /* 1D: refines DIM_LIGHT's x below the light selection's grid */
 #define DIM_LIGHT 3u          /* 2D: x chooses the light and, remapped, with y the point on it
                                  (or the direction in its spherical triangle): one stratified
                                  sample for both (discrete.cl) */
-#define DIM_DIRECTION 5u      /* 2D: hemisphere or BSDF direction (hemisphere, BSDF, MIS, ambient);
-                                 the path goes on along bsdf_sample of these same numbers */
+#define DIM_DIRECTION 5u      /* 2D: hemisphere or BSDF direction (hemisphere, MIS, ambient) */
 #define DIM_PIXEL_ROTATION 7u /* 2D, per pixel: rotation of the Fibonacci spiral */
 /* Dimensions DIM_USER, DIM_USER + 1, ... belong to users' estimators: no built-in code uses
  * them, now or later (docs/ESTIMATORS.md); DIM_USER_PER_VERTEX of them at each vertex. */

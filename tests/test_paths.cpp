@@ -3,7 +3,6 @@
 // reflections sees L_e(1 − ρ^(N+1))/(1 − ρ), and an open floor under a uniform sky, which sees only
 // the sky at every depth — and bit for bit across batch sizes and devices at depth 8.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <cstring>
 
@@ -69,7 +68,8 @@ TEST_CASE("a closed furnace renders Le (1 - rho^(N+1)) / (1 - rho) at depth N",
         path_cases({"mis", "light-area", "hemisphere-cosine", "bsdf", "light-solid-angle"});
     REQUIRE(cases.size() == 5);
     for (const Depth& d : depths) {
-        glm::dvec3 exact = glm::dvec3(Le) * (1.0 - glm::pow(glm::dvec3(albedo), glm::dvec3(d.max_depth + 1.0))) /
+        glm::dvec3 exact = glm::dvec3(Le) *
+                           (1.0 - glm::pow(glm::dvec3(albedo), glm::dvec3(d.max_depth + 1.0))) /
                            (1.0 - glm::dvec3(albedo));
         for (const EstimatorCase& v : cases)
             for (const char* sampler : {"independent", "sobol"}) {
@@ -80,8 +80,9 @@ TEST_CASE("a closed furnace renders Le (1 - rho^(N+1)) / (1 - rho) at depth N",
                 settings.rr_depth = d.rr_depth;
                 Renders r = independent_renders(device, data, settings, kRenders, kFirstSeed);
                 check_close(r, exact,
-                            v.label() + " / " + sampler + " at depth " + std::to_string(d.max_depth) +
-                                ", roulette from " + std::to_string(d.rr_depth));
+                            v.label() + " / " + sampler + " at depth " +
+                                std::to_string(d.max_depth) + ", roulette from " +
+                                std::to_string(d.rr_depth));
             }
     }
 }
@@ -161,7 +162,8 @@ TEST_CASE("an open floor under a uniform sky renders albedo x L_sky at every dep
 TEST_CASE("without --sky a direct estimator's escaping rays see black", "[paths]") {
     DeviceContext device = first_device();
     Scene scene;
-    add_quad(scene, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, add_material(scene, glm::vec3(0.5f)));
+    add_quad(scene, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3},
+             add_material(scene, glm::vec3(0.5f)));
     Camera camera = looking_down(glm::vec3(0, 3, 0), glm::radians(120.0f));  // sees past the floor
     RenderSettings settings;
     settings.width = 8;

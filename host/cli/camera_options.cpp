@@ -1,10 +1,9 @@
 #include "cli/camera_options.h"
 
 #include <cmath>
+#include <glm/glm.hpp>
 #include <sstream>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "cli/validators.h"
 #include "common/error.h"
@@ -36,15 +35,16 @@ glm::dvec3 parse_vector(const std::string& option, const std::string& text) {
 }  // namespace
 
 void add_camera_options(CLI::App* cmd, CameraOptions& o, CLI::Option* excludes) {
-    CLI::Option* from =
-        cmd->add_option("--look-from", o.look_from, "camera position X,Y,Z (replaces the scene's camera)");
+    CLI::Option* from = cmd->add_option("--look-from", o.look_from,
+                                        "camera position X,Y,Z (replaces the scene's camera)");
     CLI::Option* at = cmd->add_option("--look-at", o.look_at, "point the camera looks at, X,Y,Z");
-    CLI::Option* up =
-        cmd->add_option("--up", o.up, "camera up direction X,Y,Z (with --look-from)")->capture_default_str();
-    CLI::Option* fov = cmd->add_option("--fov", o.fov, "vertical field of view in degrees (with --look-from)")
-                           ->capture_default_str()
-                           ->check(kFinite)
-                           ->check(CLI::Range(0.01f, 179.0f));
+    CLI::Option* up = cmd->add_option("--up", o.up, "camera up direction X,Y,Z (with --look-from)")
+                          ->capture_default_str();
+    CLI::Option* fov =
+        cmd->add_option("--fov", o.fov, "vertical field of view in degrees (with --look-from)")
+            ->capture_default_str()
+            ->check(kFinite)
+            ->check(CLI::Range(0.01f, 179.0f));
     from->needs(at);
     at->needs(from);
     up->needs(from);
@@ -60,7 +60,8 @@ std::optional<Camera> look_at_camera(const CameraOptions& o) {
     const glm::dvec3 view = at - eye;
     const double distance = glm::length(view);
     if (!(distance > 0.0) || !std::isfinite(distance))
-        throw InputError("--look-at " + o.look_at + ": the same point as --look-from " + o.look_from);
+        throw InputError("--look-at " + o.look_at + ": the same point as --look-from " +
+                         o.look_from);
     const glm::dvec3 forward = view / distance;
     const double up_length = glm::length(up_hint);
     if (!(up_length > 0.0) || !std::isfinite(up_length))

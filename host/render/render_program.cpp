@@ -33,8 +33,8 @@ std::string render_program_options(const RenderSettings& settings) {
         uses = estimator.uses;
         // The ambient estimators integrate sky visibility, not reflected light: no path to extend.
         if ((uses & kUsesSky) && settings.max_depth > 1)
-            throw InputError("--max-depth " + std::to_string(settings.max_depth) + ": --estimator " +
-                             settings.estimator +
+            throw InputError("--max-depth " + std::to_string(settings.max_depth) +
+                             ": --estimator " + settings.estimator +
                              " is an ambient estimator (sky visibility, one bounce): --max-depth "
                              "0 or 1; path tracing under the sky is --sky R,G,B with light-area, "
                              "light-solid-angle, bsdf, hemisphere-* or mis");
