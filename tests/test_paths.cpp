@@ -72,7 +72,7 @@ TEST_CASE("a closed furnace renders Le (1 - rho^(N+1)) / (1 - rho) at depth N",
                            (1.0 - glm::pow(glm::dvec3(albedo), glm::dvec3(d.max_depth + 1.0))) /
                            (1.0 - glm::dvec3(albedo));
         for (const EstimatorCase& v : cases)
-            for (const char* sampler : {"independent", "sobol"}) {
+            for (const char* sampler : {"independent", "stratified", "sobol"}) {
                 v.apply(settings);
                 settings.sampler = sampler;
                 settings.replicates = resolve_replicates(0, settings);
