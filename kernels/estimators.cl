@@ -44,15 +44,16 @@ inline float3 estimate_light_solid_angle(const SceneView* scene, const SurfacePo
 /* ---- Integrating over directions --------------------------------------------------------- */
 
 /* f·Le·cosθ / pdf(ω) for a direction w (local frame, z up) of density pdf_w that finds an
- * emitter (GI Compendium eqs. 34, 35). */
+ * emitter, or leaves the scene toward the sky light (GI Compendium eqs. 34, 35). */
 inline float3 estimate_emitter_along(const SceneView* scene, const SurfacePoint* sp, float3 w,
                                      float pdf_w, uint* rays) {
     if (!(pdf_w > 0.0f) || w.z <= 0.0f) return (float3)(0.0f);
     Frame frame = frame_from_normal(sp->n);
     float3 wi = frame_to_world(&frame, w);
     SurfacePoint seen;
-    if (!trace_from(scene, sp, wi, rays, &seen)) return (float3)(0.0f);
-    return bsdf_eval(sp, wi) * emitted_radiance(&seen) * (w.z / pdf_w);
+    float3 Le = trace_from(scene, sp, wi, rays, &seen) ? emitted_radiance(&seen)
+                                                       : environment_radiance(scene);
+    return bsdf_eval(sp, wi) * Le * (w.z / pdf_w);
 }
 
 /* Directions uniform on the hemisphere, density 1/(2π) (eq. 34). */
@@ -71,14 +72,15 @@ inline float3 estimate_hemisphere_cosine(const SceneView* scene, const SurfacePo
 
 /* Directions by the BSDF's own sampling density (bsdf.cl: cosine on a Lambertian surface, the
  * density of hemisphere-cosine; GGX's visible normals for the specular lobe), counting the
- * emitters they hit: f·Le·cosθ / pdf(ω). */
+ * emitters (and the sky light) they hit: the BSDF strategy of MIS alone (PBRT 3rd ed. 14.3.1). */
 inline float3 estimate_bsdf(const SceneView* scene, const SurfacePoint* sp,
                             const SampleStream* stream, uint* rays) {
     BsdfSample bs = bsdf_sample(sp, sample_2d(stream, DIM_DIRECTION));
     if (!(bs.pdf_w > 0.0f) || bs.cos_theta <= 0.0f) return (float3)(0.0f);
     SurfacePoint seen;
-    if (!trace_from(scene, sp, bs.wi, rays, &seen)) return (float3)(0.0f);
-    return bs.f * emitted_radiance(&seen) * (bs.cos_theta / bs.pdf_w);
+    float3 Le = trace_from(scene, sp, bs.wi, rays, &seen) ? emitted_radiance(&seen)
+                                                          : environment_radiance(scene);
+    return bs.f * Le * (bs.cos_theta / bs.pdf_w);
 }
 
 /* ---- Multiple importance sampling -------------------------------------------------------- */
@@ -103,14 +105,20 @@ inline float3 estimate_mis(const SceneView* scene, const SurfacePoint* sp,
         }
     }
 
-    /* BSDF strategy: the emitter its direction finds, if any. */
+    /* BSDF strategy: the emitter its direction finds, if any, or the sky light. */
     BsdfSample bs = bsdf_sample(sp, sample_2d(stream, DIM_DIRECTION));
     SurfacePoint seen;
-    if (bs.pdf_w > 0.0f && bs.cos_theta > 0.0f && trace_from(scene, sp, bs.wi, rays, &seen)) {
-        float3 Le = emitted_radiance(&seen);
-        if (any(Le != (float3)(0.0f))) {
-            float pdf_light = pdf_light_area(scene, sp, &seen, bs.wi);
-            L += bs.f * Le * (bs.cos_theta / bs.pdf_w * mis_weight(bs.pdf_w, pdf_light));
+    if (bs.pdf_w > 0.0f && bs.cos_theta > 0.0f) {
+        if (trace_from(scene, sp, bs.wi, rays, &seen)) {
+            float3 Le = emitted_radiance(&seen);
+            if (any(Le != (float3)(0.0f))) {
+                float pdf_light = pdf_light_area(scene, sp, &seen, bs.wi);
+                L += bs.f * Le * (bs.cos_theta / bs.pdf_w * mis_weight(bs.pdf_w, pdf_light));
+            }
+        } else if (scene->env.sky_pmf > 0.0f) {
+            float pdf_light = pdf_light_sky(scene, sp, bs.wi);
+            L +=
+                bs.f * scene->env.sky * (bs.cos_theta / bs.pdf_w * mis_weight(bs.pdf_w, pdf_light));
         }
     }
     return L;

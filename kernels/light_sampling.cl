@@ -5,6 +5,7 @@
 #ifndef MCRT_LIGHT_SAMPLING_CL
 #define MCRT_LIGHT_SAMPLING_CL
 
+#include "frame.cl"
 #include "lights.cl"
 #include "sampling.cl"
 #include "scene.cl"
@@ -28,7 +29,7 @@ typedef struct {
     float d2;        /* |y − x|² */
     float cos_light; /* cosine at the light between its emitting normal and −wi, > 0 */
     uint measure;    /* LIGHT_MEASURE_AREA or LIGHT_MEASURE_SOLID_ANGLE */
-    uint light;      /* index of the chosen light */
+    uint light;      /* index of the chosen light; LIGHT_SKY for the sky */
     bool valid;      /* false: the sample adds nothing (no lights, a back face, degenerate) */
 } LightSample;
 
@@ -39,6 +40,57 @@ inline LightSample no_light_sample(void) {
     ls.measure = LIGHT_MEASURE_AREA;
     ls.light = 0u;
     ls.valid = false;
+    return ls;
+}
+
+/* LightSample.light of a direction toward the sky light. */
+#define LIGHT_SKY 0xffffffffu
+
+/* ---- The sky beside the area lights ---------------------------------------------------------- */
+
+/* Chooses between the sky light, with probability env.sky_pmf, and the area lights, as pbrt-v4
+ * keeps infinite lights beside its light sampler (BVHLightSampler's pInfinite). sky_pmf is 0, 1/2
+ * (sky and area lights) or 1 (the sky alone), so the split of u on its 2^-24 grid is exact: true
+ * for the sky, *u remapped uniform for its direction; false for the area lights, *u and *u_fine
+ * remapped so that the light selection reads them as before, with probability 1 − sky_pmf. */
+inline bool select_sky(const SceneView* scene, float* u, float* u_fine) {
+    float sky_pmf = scene->env.sky_pmf;
+    if (!(sky_pmf > 0.0f)) return false;
+    if (sky_pmf >= 1.0f) return true;
+    uint k = unit_to_grid(*u), lower = 0x800000u; /* the lower half of the grid */
+    if (k < lower) {
+        *u = remap_run(k, 0u, lower, *u_fine);
+        return true;
+    }
+    /* The upper half's k − lower has 23 bits: u_fine's first bit is the 24th, the rest its fine. */
+    uint bit = *u_fine >= 0.5f ? 1u : 0u;
+    *u = (float)(2u * (k - lower) + bit) * 0x1.0p-24f;
+    *u_fine = 2.0f * *u_fine - (float)bit;
+    return false;
+}
+
+/* Probability that the light strategies choose among the area lights. */
+inline float area_lights_pmf(const SceneView* scene) { return 1.0f - scene->env.sky_pmf; }
+
+/* A direction toward the sky: cosine-weighted about the normal (the sky's radiance is uniform,
+ * so this is the importance of a Lambertian receiver; GI Compendium eq. 35), in solid angle. */
+inline LightSample sample_light_sky(const SceneView* scene, const SurfacePoint* sp, float2 u) {
+    LightSample ls = no_light_sample();
+    float3 w = sample_hemisphere_cosine(u);
+    float pdf_w = sample_hemisphere_cosine_pdf_w(w);
+    if (!(pdf_w > 0.0f)) return ls;
+    Frame frame = frame_from_normal(sp->n);
+    ls.wi = frame_to_world(&frame, w);
+    ls.y = sp->p + ls.wi;
+    ls.n_toward = -ls.wi;
+    ls.Le = scene->env.sky;
+    ls.pmf = scene->env.sky_pmf;
+    ls.pdf = pdf_w;
+    ls.d2 = 1.0f;
+    ls.cos_light = 1.0f;
+    ls.measure = LIGHT_MEASURE_SOLID_ANGLE;
+    ls.light = LIGHT_SKY;
+    ls.valid = true;
     return ls;
 }
 
@@ -58,6 +110,10 @@ inline float light_area_pdf_w(float pmf, float pdf_a, float d2, float cos_light)
 
 inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint* sp, float2 u,
                                      float u_fine) {
+    float u_select = u.x; /* a vector's element has no address in OpenCL C */
+    if (select_sky(scene, &u_select, &u_fine))
+        return sample_light_sky(scene, sp, (float2)(u_select, u.y));
+    u.x = u_select;
     LightSample ls = no_light_sample();
     if (scene->lights.light_count == 0u) return ls;
     DiscreteSample choice = select_light(&scene->lights, sp->p, sp->n, u.x, u_fine);
@@ -75,7 +131,7 @@ inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint*
     ls.y = lp.p;
     ls.n_toward = dot(n_light, wi) < 0.0f ? n_light : -n_light;
     ls.Le = light.Le.xyz;
-    ls.pmf = choice.pmf;
+    ls.pmf = choice.pmf * area_lights_pmf(scene);
     ls.pdf = lp.pdf_a;
     ls.d2 = d2;
     ls.cos_light = cos_y;
@@ -91,6 +147,10 @@ inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint*
  * area sampling, a choice fixed by (point, light), so the estimator stays unbiased. */
 inline LightSample sample_light_solid_angle(const SceneView* scene, const SurfacePoint* sp,
                                             float2 u_light, float u_fine) {
+    float u_select = u_light.x;
+    if (select_sky(scene, &u_select, &u_fine))
+        return sample_light_sky(scene, sp, (float2)(u_select, u_light.y));
+    u_light.x = u_select;
     LightSample ls = no_light_sample();
     if (scene->lights.light_count == 0u) return ls;
     DiscreteSample choice = select_light(&scene->lights, sp->p, sp->n, u_light.x, u_fine);
@@ -133,7 +193,7 @@ inline LightSample sample_light_solid_angle(const SceneView* scene, const Surfac
     ls.y = y;
     ls.n_toward = dot(n_light, wi) < 0.0f ? n_light : -n_light;
     ls.Le = light.Le.xyz;
-    ls.pmf = choice.pmf;
+    ls.pmf = choice.pmf * area_lights_pmf(scene);
     ls.pdf = pdf_w;
     ls.d2 = dot(d, d);
     ls.cos_light = cos_y;
@@ -164,6 +224,10 @@ inline float light_sample_pdf_w(const LightSample* ls) {
 /* True if nothing blocks the segment from the shading point to the light sample. */
 inline bool light_sample_visible(const SceneView* scene, const SurfacePoint* sp,
                                  const LightSample* ls) {
+    if (ls->light == LIGHT_SKY) { /* nothing along the ray to infinity */
+        Ray r = make_ray(offset_ray_origin(sp->p, sp->n), ls->wi);
+        return !bvh_any_hit(scene->nodes, scene->packets, &r, MAXFLOAT);
+    }
     return visible(scene, sp->p, sp->n, ls->y, ls->n_toward);
 }
 
@@ -178,8 +242,9 @@ inline float pdf_light_area(const SceneView* scene, const SurfacePoint* sp,
     Light light = scene->lights.lights[index];
     float3 d = seen->p - sp->p;
     float cos_y = fabs(dot(seen->n, wi));
-    return light_area_pdf_w(light_pmf(&scene->lights, sp->p, sp->n, index),
-                            sample_triangle_uniform_pdf_a(light_area(&light)), dot(d, d), cos_y);
+    float pmf = light_pmf(&scene->lights, sp->p, sp->n, index) * area_lights_pmf(scene);
+    return light_area_pdf_w(pmf, sample_triangle_uniform_pdf_a(light_area(&light)), dot(d, d),
+                            cos_y);
 }
 
 /* Density with respect to solid angle with which sample_light_solid_angle would have chosen wi;
@@ -197,11 +262,20 @@ inline float pdf_light_solid_angle(const SceneView* scene, const SurfacePoint* s
     float3 a = normalize(light.p0.xyz - x), b = normalize(light.p1.xyz - x),
            c = normalize(light.p2.xyz - x);
     float omega = spherical_triangle_solid_angle(a, b, c);
-    float pmf = light_pmf(&scene->lights, sp->p, sp->n, index);
+    float pmf = light_pmf(&scene->lights, sp->p, sp->n, index) * area_lights_pmf(scene);
     if (omega > MIN_SPHERICAL_SOLID_ANGLE && omega < MAX_SPHERICAL_SOLID_ANGLE) return pmf / omega;
     float3 d = seen->p - x;
     return pmf * pdf_area_to_solid_angle(sample_triangle_uniform_pdf_a(light_area(&light)),
                                          dot(d, d), cos_y);
+}
+
+/* Density with respect to solid angle with which either light strategy chooses the sky direction
+ * wi (unit, world) from sp, the twin of sample_light_sky with the sky's pmf; 0 when the sky is
+ * no light. */
+inline float pdf_light_sky(const SceneView* scene, const SurfacePoint* sp, float3 wi) {
+    if (!(scene->env.sky_pmf > 0.0f)) return 0.0f;
+    Frame frame = frame_from_normal(sp->n);
+    return scene->env.sky_pmf * sample_hemisphere_cosine_pdf_w(frame_to_local(&frame, wi));
 }
 
 #endif

@@ -3,39 +3,18 @@
 #include "camera.cl"
 #include "estimators.cl"
 #include "user_estimator.cl"
-
-#if !defined(MCRT_ESTIMATE)
-#error "no estimator selected: the host defines MCRT_ESTIMATE (host/render/variants.cpp)"
-#endif
-
-/* Radiance arriving along a camera ray: Le at the first hit plus the estimator's estimate of
- * the reflected light; a ray leaving the scene sees black, or the sky for estimators that use
- * it (-D ESTIMATOR_USES_SKY; DESIGN.md "Radiometric contract"). Counts the rays in *rays. */
-inline float3 radiance(const SceneView* scene, const Ray* r, const SampleStream* stream,
-                       uint* rays) {
-    *rays += 1u;
-    Hit hit = bvh_closest_hit(scene->nodes, scene->packets, r, MAXFLOAT);
-#if defined(ESTIMATOR_USES_SKY)
-    if (hit.lane == MCRT_NO_HIT) return scene->env.sky;
-#else
-    if (hit.lane == MCRT_NO_HIT) return (float3)(0.0f);
-#endif
-    SurfacePoint sp = surface_point(scene, r, &hit);
-    float3 L = emitted_radiance(&sp);
-    L += MCRT_ESTIMATE(scene, &sp, stream, rays);
-    return L;
-}
+#include "path.cl"
 
 /* One work-item per pixel sample of a batch. Work-item g renders sample
  * p.sample_begin + g % p.batch_samples (of p.spp in all) of pixel
- * p.pixel_begin + g / p.batch_samples < p.pixel_end (samples of a pixel adjacent) and writes
- * samples[g] = (radiance, rays traced). Arguments in the order of RenderArgument. */
+ * p.pixel_begin + g / p.batch_samples < p.pixel_end (samples of a pixel adjacent) along a path
+ * of at most p.max_depth reflections (path.cl) and writes samples[g] = (the radiance's bits, the
+ * packed PathRecord). Arguments in the order of RenderArgument. */
 kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                    global const TriangleInfo* triangle_info, global const Material* materials,
                    global const Light* lights, global const float* light_cdf,
                    global const AliasEntry* light_alias, global const LightTreeNode* light_tree,
-                   global const CameraGpu* camera,
-                   global float4* samples, RenderParams p) {
+                   global const CameraGpu* camera, global uint4* samples, RenderParams p) {
     size_t g = get_global_id(0);
     uint pixel = p.pixel_begin + (uint)(g / p.batch_samples);
     if (pixel >= p.pixel_end) return; /* the global size is rounded up to whole work-groups */
@@ -47,6 +26,7 @@ kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* pa
     stream.sample = stream.index / p.replicates;
     stream.sample_count = p.spp / p.replicates;
     stream.seed = p.seed;
+    stream.vertex = 0u;
 
     SceneView scene;
     scene.nodes = nodes;
@@ -60,13 +40,17 @@ kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* pa
     scene.lights.light_count = p.light_count;
     scene.env.sky = p.sky.xyz;
     scene.env.ao_distance = p.ao_distance;
+    scene.env.sky_pmf = p.sky.w;
+    TraceMemo memo;
+    memo.valid = false;
+    scene.memo = p.max_depth > 1u ? &memo : 0; /* direct lighting has no continuation */
 
     float3 dir = camera_direction(camera, pixel % p.width, pixel / p.width,
                                   sample_2d(&stream, DIM_PIXEL_JITTER), p.width, p.height);
     Ray r = make_ray(camera->eye.xyz, dir);
-    uint rays = 0u;
-    float3 L = radiance(&scene, &r, &stream, &rays);
-    samples[g] = (float4)(L, (float)rays);
+    PathRecord record = {0u, 0u, false};
+    float3 L = path_radiance(&scene, &r, &stream, p.max_depth, p.rr_depth, &record);
+    samples[g] = (uint4)(as_uint3(L), pack_path_record(&record));
 }
 
 inline bool finite3(float3 v) {
@@ -80,9 +64,10 @@ inline bool finite3(float3 v) {
  * 16, which `replicates` divides: local sample k belongs to replicate k % replicates).
  * Work-item g handles chunk g % chunks of pixel g / chunks, chunks =
  * ceil(batch_samples / MCRT_SAMPLES_PER_CHUNK), and writes sums[g · replicates + r] for each
- * replicate r (ChunkSums: shifted and scaled, so that nothing cancels or overflows). Non-finite
- * samples are counted and read as 0. */
-kernel void reduce_chunks(global const float4* samples, uint batch_samples, uint pixel_count,
+ * replicate r (ChunkSums: shifted and scaled, so that nothing cancels or overflows; with the
+ * rays, path vertices and roulette ends of the packed PathRecords). Non-finite samples are
+ * counted and read as 0. */
+kernel void reduce_chunks(global const uint4* samples, uint batch_samples, uint pixel_count,
                           uint replicates, global ChunkSums* sums) {
     size_t g = get_global_id(0);
     uint chunks = (batch_samples + MCRT_SAMPLES_PER_CHUNK - 1u) / MCRT_SAMPLES_PER_CHUNK;
@@ -90,19 +75,23 @@ kernel void reduce_chunks(global const float4* samples, uint batch_samples, uint
     if (pixel >= pixel_count) return;
     uint begin = (uint)(g % chunks) * MCRT_SAMPLES_PER_CHUNK;
     uint end = min(begin + MCRT_SAMPLES_PER_CHUNK, batch_samples);
-    global const float4* x = samples + (size_t)pixel * batch_samples;
+    global const uint4* x = samples + (size_t)pixel * batch_samples;
     for (uint r = 0u; r < replicates; ++r) {
         /* The shift (first value) and the largest magnitude, per channel. */
         float3 shift = (float3)(0.0f), largest = (float3)(0.0f);
         float bad = 0.0f, rays = 0.0f, n = 0.0f;
+        uint vertices = 0u, roulette = 0u;
         for (uint k = begin + r; k < end; k += replicates) {
-            float4 sample = x[k];
-            bool ok = finite3(sample.xyz);
-            float3 v = ok ? sample.xyz : (float3)(0.0f);
+            uint4 sample = x[k];
+            float3 L = as_float3(sample.xyz);
+            bool ok = finite3(L);
+            float3 v = ok ? L : (float3)(0.0f);
             if (n == 0.0f) shift = v;
             largest = fmax(largest, fabs(v));
             bad += ok ? 0.0f : 1.0f;
-            rays += sample.w;
+            rays += (float)path_record_rays(sample.w);
+            vertices += path_record_vertices(sample.w);
+            roulette += path_record_roulette(sample.w);
             n += 1.0f;
         }
         /* 2^e at most the largest magnitude: scaled values are below 2 in magnitude. */
@@ -110,7 +99,7 @@ kernel void reduce_chunks(global const float4* samples, uint batch_samples, uint
         float3 s = (float3)(0.0f), s2 = (float3)(0.0f);
         float3 shift_scaled = ldexp(shift, -e);
         for (uint k = begin + r; k < end; k += replicates) {
-            float3 v = x[k].xyz;
+            float3 v = as_float3(x[k].xyz);
             v = finite3(v) ? v : (float3)(0.0f);
             float3 d = ldexp(v, -e) - shift_scaled;
             s += d;
@@ -120,7 +109,7 @@ kernel void reduce_chunks(global const float4* samples, uint batch_samples, uint
         out.shift = (float4)(shift, bad);
         out.sum = (float4)(s, rays);
         out.sum_sq = (float4)(s2, n);
-        out.exponent = (float4)(convert_float3(e), 0.0f);
+        out.exponent = (float4)(convert_float3(e), (float)(vertices + (roulette << 15)));
         sums[g * replicates + r] = out;
     }
 }

@@ -35,14 +35,22 @@ typedef struct {
     uint seed;
     uint replicate;    /* which randomization, 0 .. replicates − 1 */
     uint index;        /* index of the sample within the pixel: replicate + replicates · sample */
+    uint vertex;       /* the path's vertex the numbers are for: 0 at the camera's hit, k after
+                          k reflections (stream_dimension) */
 } SampleStream;
 
 /* The seed of this replicate's randomization: the render's seed for replicate 0. */
 inline uint replicate_seed(const SampleStream* s) { return s->seed ^ (s->replicate * 0x9E3779B9u); }
 
 /* Dimensions of the stream, shared by every estimator (a user's too) so that two estimators
- * are compared on the same samples (common random numbers). A 2D dimension d uses d and d + 1. */
-#define DIM_PIXEL_JITTER 0u   /* 2D */
+ * are compared on the same samples (common random numbers). A 2D dimension d uses d and d + 1.
+ * They are the dimensions of one path vertex: vertex k of a path (k reflections after the
+ * camera's hit) reads dimension d as stream_dimension() maps it, so that each vertex has its
+ * own numbers and an estimator is written once for every vertex. */
+/* DIM_ROULETTE, at vertices k >= 1 only (the jitter's slot): Russian roulette before the path
+ * reaches vertex k (path.cl). The path goes on by bsdf_sample of DIM_DIRECTION's numbers. */
+#define DIM_PIXEL_JITTER 0u   /* 2D, vertex 0 only: the point in the pixel */
+#define DIM_ROULETTE 0u       /* 1D, vertices k >= 1 */
 #define DIM_LIGHT_FINE 2u     /* 1D: refines DIM_LIGHT's x below the light selection's grid */
 #define DIM_LIGHT 3u          /* 2D: x chooses the light and, remapped, with y the point on it
                                  (or the direction in its spherical triangle): one stratified
@@ -50,8 +58,25 @@ inline uint replicate_seed(const SampleStream* s) { return s->seed ^ (s->replica
 #define DIM_DIRECTION 5u      /* 2D: hemisphere or BSDF direction (hemisphere, MIS, ambient) */
 #define DIM_PIXEL_ROTATION 7u /* 2D, per pixel: rotation of the Fibonacci spiral */
 /* Dimensions DIM_USER, DIM_USER + 1, ... belong to users' estimators: no built-in code uses
- * them, now or later (docs/ESTIMATORS.md). */
+ * them, now or later (docs/ESTIMATORS.md); DIM_USER_PER_VERTEX of them at each vertex. */
 #define DIM_USER 0x100000u
+#define DIM_USER_PER_VERTEX 0x100u
+/* Built-in dimensions per vertex: vertex k uses DIM_PER_VERTEX·k + d. */
+#define DIM_PER_VERTEX 8u
+/* The stratified and Sobol' samplers cover the first MCRT_QMC_VERTICES vertices of a path; past
+ * them every number is independent (pcg4d), so a deep path never runs out of dimensions and pays
+ * for no strata where the integrand is too high-dimensional for them to help (PBRT 3rd ed. 7.2.3
+ * on padding; the independent sampler is the same everywhere). */
+#define MCRT_QMC_VERTICES 16u
+/* The stream's dimension for estimator dimension dim at the stream's vertex: dim itself at
+ * vertex 0 (so that direct lighting reads exactly the numbers it always did). */
+inline uint stream_dimension(const SampleStream* s, uint dim) {
+    if (dim >= DIM_USER) return dim + s->vertex * DIM_USER_PER_VERTEX;
+    return dim + s->vertex * DIM_PER_VERTEX;
+}
+
+/* True for a mapped dimension past the stratified / Sobol' vertices: independent numbers. */
+inline bool past_qmc_vertices(const SampleStream* s) { return s->vertex >= MCRT_QMC_VERTICES; }
 
 /* Independent uniform number of dimension dim: pcg4d(pixel, sample, dim, seed).x. */
 inline float independent_1d(uint pixel, uint sample, uint dim, uint seed) {
@@ -65,6 +90,7 @@ inline uint pixel_dimension_key(const SampleStream* s, uint dim) {
 
 /* Numbers that depend on the pixel only, not on the sample (e.g. a per-pixel rotation). */
 inline float2 pixel_2d(const SampleStream* s, uint dim) {
+    dim = stream_dimension(s, dim);
     uint4 h = pcg4d((uint4)(s->pixel, 0xfffffffeu, dim, replicate_seed(s)));
     return (float2)(uint_to_unit_float(h.x), uint_to_unit_float(h.y));
 }
@@ -105,13 +131,13 @@ inline uint kensler_permute(uint i, uint l, uint p) {
 /* Jittered strata: sample k of the pixel falls in stratum permute(k) of sample_count strata
  * (1D) or of an nx × ny grid (2D, per dimension pair), each pair with its own permutation so
  * that pairs are not correlated; uniform jitter inside the stratum (PBRT 3rd ed. 7.3). */
-inline float sample_1d(const SampleStream* s, uint dim) {
+inline float sampler_1d(const SampleStream* s, uint dim) {
     uint stratum = kensler_permute(s->sample, s->sample_count, pixel_dimension_key(s, dim));
     float jitter = independent_1d(s->pixel, s->index, dim, s->seed);
     return min(((float)stratum + jitter) / (float)s->sample_count, 0x1.fffffep-1f);
 }
 
-inline float2 sample_2d(const SampleStream* s, uint dim) {
+inline float2 sampler_2d(const SampleStream* s, uint dim) {
     uint nx = (uint)ceil(sqrt((float)s->sample_count));
     while (nx * nx < s->sample_count) ++nx; /* float sqrt may round down */
     uint ny = (s->sample_count + nx - 1u) / nx;
@@ -158,7 +184,7 @@ inline uint sobol_dimension_1(uint index) {
 
 /* Owen-scrambled Sobol' (0,2)-sequence per dimension pair, padded by shuffling the sample index
  * with an independent scramble for each pair (Burley 2020, sec. 4). */
-inline float2 sample_2d(const SampleStream* s, uint dim) {
+inline float2 sampler_2d(const SampleStream* s, uint dim) {
     uint key = pixel_dimension_key(s, dim);
     uint index = nested_uniform_scramble(s->sample, key);
     uint x = nested_uniform_scramble(reverse_bits(index), pcg4d((uint4)(key, 1u, 0u, 0u)).x);
@@ -166,7 +192,7 @@ inline float2 sample_2d(const SampleStream* s, uint dim) {
     return (float2)(uint_to_unit_float(x), uint_to_unit_float(y));
 }
 
-inline float sample_1d(const SampleStream* s, uint dim) {
+inline float sampler_1d(const SampleStream* s, uint dim) {
     uint key = pixel_dimension_key(s, dim);
     uint index = nested_uniform_scramble(s->sample, key);
     return uint_to_unit_float(
@@ -174,14 +200,31 @@ inline float sample_1d(const SampleStream* s, uint dim) {
 }
 
 #else /* SAMPLER_INDEPENDENT */
-inline float sample_1d(const SampleStream* s, uint dim) {
+inline float sampler_1d(const SampleStream* s, uint dim) {
     return independent_1d(s->pixel, s->index, dim, s->seed);
 }
 
 /* Dimensions dim and dim + 1. */
-inline float2 sample_2d(const SampleStream* s, uint dim) {
-    return (float2)(sample_1d(s, dim), sample_1d(s, dim + 1u));
+inline float2 sampler_2d(const SampleStream* s, uint dim) {
+    return (float2)(sampler_1d(s, dim), sampler_1d(s, dim + 1u));
 }
 #endif
+
+/* ---- What estimators call ------------------------------------------------------------------- */
+
+/* The number of dimension dim (or the pair dim, dim + 1) at the stream's vertex. */
+inline float sample_1d(const SampleStream* s, uint dim) {
+    uint d = stream_dimension(s, dim);
+    if (past_qmc_vertices(s)) return independent_1d(s->pixel, s->index, d, s->seed);
+    return sampler_1d(s, d);
+}
+
+inline float2 sample_2d(const SampleStream* s, uint dim) {
+    uint d = stream_dimension(s, dim);
+    if (past_qmc_vertices(s))
+        return (float2)(independent_1d(s->pixel, s->index, d, s->seed),
+                        independent_1d(s->pixel, s->index, d + 1u, s->seed));
+    return sampler_2d(s, d);
+}
 
 #endif

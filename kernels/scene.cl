@@ -5,11 +5,16 @@
 #include "bvh_traverse.cl"
 #include "lights.cl"
 
-/* The uniform environment of the ambient estimators (DESIGN.md "Radiometric contract"). */
+/* The uniform environment (DESIGN.md "Radiometric contract"): the ambient estimators' sky, or,
+ * with --sky and a direct or path estimator, a light at infinity beside the area lights. */
 typedef struct {
     float3 sky;        /* radiance of the uniform sky */
     float ao_distance; /* occlusion range; 0 = unbounded */
+    float sky_pmf;     /* probability that the light strategies choose the sky light; 0: the sky
+                          is no light (light_sampling.cl) */
 } Environment;
+
+typedef struct TraceMemo TraceMemo;
 
 typedef struct {
     global const Bvh4Node* nodes;
@@ -18,6 +23,7 @@ typedef struct {
     global const Material* materials;
     LightSet lights;
     Environment env;
+    TraceMemo* memo; /* the last ray of trace_from, for the path's continuation; 0: none kept */
 } SceneView;
 
 /* A surface point seen along a ray. */
@@ -49,10 +55,25 @@ inline SurfacePoint surface_point(const SceneView* scene, const Ray* r, const Hi
     return sp;
 }
 
+/* The last ray trace_from traced and what it found: when an estimator's BSDF or hemisphere
+ * direction is also the path's continuation (path.cl), the path takes the surface from here
+ * instead of tracing the same ray again. */
+struct TraceMemo {
+    float3 origin, wi;
+    SurfacePoint seen;
+    bool hit;
+    bool valid;
+};
+
 /* Radiance the surface emits toward the viewer: front face only unless double-sided. */
 inline float3 emitted_radiance(const SurfacePoint* sp) {
     bool emits = sp->front || (sp->material.flags & MATERIAL_DOUBLE_SIDED) != 0u;
     return emits ? sp->material.Le.xyz : (float3)(0.0f);
+}
+
+/* Radiance that a ray leaving the scene sees: the sky when it is a light, else black. */
+inline float3 environment_radiance(const SceneView* scene) {
+    return scene->env.sky_pmf > 0.0f ? scene->env.sky : (float3)(0.0f);
 }
 
 /* True if nothing blocks the segment between the offset origins of a and b; na and nb are the
@@ -71,9 +92,16 @@ inline bool trace_from(const SceneView* scene, const SurfacePoint* sp, float3 wi
     *rays += 1u;
     Ray r = make_ray(offset_ray_origin(sp->p, sp->n), wi);
     Hit hit = bvh_closest_hit(scene->nodes, scene->packets, &r, MAXFLOAT);
-    if (hit.lane == MCRT_NO_HIT) return false;
-    *seen = surface_point(scene, &r, &hit);
-    return true;
+    bool found = hit.lane != MCRT_NO_HIT;
+    if (found) *seen = surface_point(scene, &r, &hit);
+    if (scene->memo) {
+        scene->memo->origin = r.org;
+        scene->memo->wi = wi;
+        scene->memo->hit = found;
+        if (found) scene->memo->seen = *seen;
+        scene->memo->valid = true;
+    }
+    return found;
 }
 
 /* True if the ray from sp along wi (unit, world) leaves the scene within t_max (MAXFLOAT:

@@ -39,6 +39,10 @@ inline uint as_uint(float f) {
  * image, do not depend on the batch size or the device split. */
 #define MCRT_SAMPLES_PER_CHUNK 16
 
+/* The longest light path, in reflections (--max-depth): the host's option check, the per-vertex
+ * random-number dimensions (rng.cl) and the packed path statistics (path.cl) agree on it. */
+#define MCRT_MAX_PATH_DEPTH 1024u
+
 /* Longest root-to-leaf path of the binary BVH, in nodes (kMaxBvhDepth on the host): the builder
  * switches to median splits before a tree could grow deeper. */
 #define MCRT_BVH_MAX_DEPTH 60
@@ -177,11 +181,13 @@ typedef struct {
     float4 forward;
 } CameraGpu;
 
-/* The per-render values of the render kernel, passed by value as its last argument, 64 bytes.
+/* The per-render values of the render kernel, passed by value as its last argument, 80 bytes.
  * Values that change per render or per launch live here, never in -D options, so they never
  * trigger a rebuild (STYLE.md). */
 typedef struct {
-    float4 sky;         /* .xyz uniform sky radiance (ambient estimators), .w unused */
+    float4 sky;         /* .xyz uniform sky radiance (ambient estimators, or the sky light);
+                           .w the probability that the light strategies choose the sky light,
+                           0 when the sky is no light (light_sampling.cl) */
     float ao_distance;  /* ambient occlusion range; 0 = unbounded */
     uint width, height; /* image size in pixels */
     uint seed;
@@ -192,7 +198,9 @@ typedef struct {
     uint batch_samples; /*   of each pixel */
     uint replicates;    /* K independent randomizations of the sampler: sample s belongs to
                            replicate s % K as its sample s / K of spp / K (K divides 16 and spp) */
-    uint pad0;
+    uint max_depth;     /* reflections a path may have (--max-depth); 1: direct lighting */
+    uint rr_depth;      /* Russian roulette before reflection k >= rr_depth (--rr-depth) */
+    uint pad0, pad1, pad2;
 } RenderParams;
 
 /* What reduce_chunks writes for one run of samples: the samples of one pixel, one chunk and one
@@ -204,7 +212,9 @@ typedef struct {
     float4 shift;    /* .xyz the run's first sample, .w non-finite samples in the run */
     float4 sum;      /* .xyz Σ (x·2^-e − shift·2^-e), .w rays traced */
     float4 sum_sq;   /* .xyz Σ (x·2^-e − shift·2^-e)², .w samples in the run */
-    float4 exponent; /* .xyz e, whole numbers; .w unused */
+    float4 exponent; /* .xyz e, whole numbers; .w path vertices of the run's samples
+                        + 2^15 × those of its paths that roulette ended (a whole number:
+                        16 × (MCRT_MAX_PATH_DEPTH + 1) vertices fit below 2^15) */
 } ChunkSums;
 
 /* The render kernel's arguments in order (kernels/render.cl); the host binds them all in one
@@ -249,12 +259,13 @@ enum RenderArgument {
     FIELD(LightTreeNode, sin_o, 60)                                                             \
     TYPE(CameraGpu, 64, 16) FIELD(CameraGpu, eye, 0) FIELD(CameraGpu, right, 16)                \
     FIELD(CameraGpu, up, 32) FIELD(CameraGpu, forward, 48)                                      \
-    TYPE(RenderParams, 64, 16) FIELD(RenderParams, sky, 0) FIELD(RenderParams, ao_distance, 16) \
+    TYPE(RenderParams, 80, 16) FIELD(RenderParams, sky, 0) FIELD(RenderParams, ao_distance, 16) \
     FIELD(RenderParams, width, 20) FIELD(RenderParams, height, 24) FIELD(RenderParams, seed, 28) \
     FIELD(RenderParams, spp, 32) FIELD(RenderParams, light_count, 36)                           \
     FIELD(RenderParams, pixel_begin, 40) FIELD(RenderParams, pixel_end, 44)                     \
     FIELD(RenderParams, sample_begin, 48) FIELD(RenderParams, batch_samples, 52)                 \
-    FIELD(RenderParams, replicates, 56)                                                         \
+    FIELD(RenderParams, replicates, 56) FIELD(RenderParams, max_depth, 60)                      \
+    FIELD(RenderParams, rr_depth, 64)                                                           \
     TYPE(ChunkSums, 64, 16) FIELD(ChunkSums, shift, 0) FIELD(ChunkSums, sum, 16)                \
     FIELD(ChunkSums, sum_sq, 32) FIELD(ChunkSums, exponent, 48)
 

@@ -82,6 +82,8 @@ def run_mcrt(args, scene, out_stem, estimator, light_select, sampler, seed, spp=
         "--width", args.width, "--height", args.height, "--materials", args.materials]
     if args.mis_heuristic and "mis-heuristic" in mcrt_run.estimator_uses(estimator, args.mcrt):
         options += ["--mis-heuristic", args.mis_heuristic]
+    if args.max_depth != 1:  # paths: the reference and every render at the same depth
+        options += ["--max-depth", args.max_depth, "--rr-depth", args.rr_depth]
     if seconds is not None:
         # mcrt stops after the time limit at a whole 16-sample chunk; the spp cap is never hit.
         options += ["--spp", "16777216", "--time-limit", repr(seconds)]
@@ -128,6 +130,8 @@ def auto_reference(args, scene, scratch):
                 "mis_heuristic": args.mis_heuristic or "balance", "spp": args.reference_spp,
                 "materials": args.materials,
                 "width": args.width, "height": args.height, "seeds": list(REFERENCE_SEEDS)}
+    if args.max_depth != 1:  # direct lighting keeps the keys of the references it had
+        settings.update(max_depth=args.max_depth, rr_depth=args.rr_depth)
     key = hashlib.sha256((scene_hash(scene) + json.dumps(settings, sort_keys=True))
                          .encode()).hexdigest()[:20]
     cache = Path(args.reference_cache) if args.reference_cache else reference_cache_dir()
@@ -381,6 +385,9 @@ def parse_args(argv=None):
     p.add_argument("--repeats", type=int, help="renders per level with different seeds (default 1)")
     p.add_argument("--seed", type=int, default=1, help="seed of repeat 0 (repeat r: seed + r)")
     p.add_argument("--crop", type=int, default=96, help="crop size of the equal-time strip")
+    p.add_argument("--max-depth", type=int, default=1,
+                   help="mcrt --max-depth of every render and of the auto reference (paths)")
+    p.add_argument("--rr-depth", type=int, default=5, help="mcrt --rr-depth with --max-depth")
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--quick", action="store_true",
                    help="32×32 image, spp 1,4,16 unless given, 1 repeat, 512 spp reference")

@@ -27,7 +27,9 @@ Mitsuba 3 scene and renders it:
              `hdrfilm` of W×H with the `box` reconstruction filter (every sample inside its
              own pixel, uniformly jittered: mcrt's pixel estimate);
   integrator `direct` (emitter_samples = bsdf_samples = 1, combined by MIS — Mitsuba's only
-             direct-light estimator), hide_emitters false.
+             direct-light estimator), hide_emitters false; with --max-depth N > 1 (mcrt's
+             reflections) `path` with max_depth = N + 1 (Mitsuba counts the camera segment)
+             and rr_depth = --rr-depth, the same light paths as `mcrt render --max-depth N`.
 
 Renders in --passes passes with different seeds and writes their mean as an EXR with R, G, B,
 a variance layer (variance.R/G/B: the variance of the mean, from the spread of the passes) and a
@@ -209,6 +211,9 @@ class Gltf:
         return eye, forward, np.array([0.0, 1.0, 0.0]), math.radians(45.0)
 
 
+DEBIAN_LLVM19 = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1"
+
+
 def write_ply(path, triangles):
     """Binary PLY of unshared vertices (flat shading needs nothing more)."""
     n = len(triangles)
@@ -252,7 +257,16 @@ def mitsuba_bsdf(material, albedo, materials):
         % (material.get("name", "material"), metallic))
 
 
-def mitsuba_scene(mi, gltf, width, height, spp, scratch, materials="lambert"):
+def integrator(max_depth, rr_depth):
+    """Mitsuba's integrator for mcrt's --max-depth (reflections): `direct` at 1, else `path`."""
+    if max_depth <= 1:
+        return {"type": "direct", "hide_emitters": False}
+    return {"type": "path", "max_depth": max_depth + 1, "rr_depth": rr_depth,
+            "hide_emitters": False}
+
+
+def mitsuba_scene(mi, gltf, width, height, spp, scratch, max_depth=1, rr_depth=5, sky=None,
+                  materials="lambert"):
     triangles = gltf.triangles()
     if not triangles:
         raise ValueError("the scene has no triangles")
@@ -262,7 +276,7 @@ def mitsuba_scene(mi, gltf, width, height, spp, scratch, materials="lambert"):
     eye, forward, up, yfov = gltf.camera((lo, hi))
     scene = {
         "type": "scene",
-        "integrator": {"type": "direct", "hide_emitters": False},
+        "integrator": integrator(max_depth, rr_depth),
         "sensor": {
             "type": "perspective", "fov_axis": "y", "fov": math.degrees(yfov),
             "near_clip": 1e-4 * diag, "far_clip": 1e3 * diag,
@@ -275,6 +289,9 @@ def mitsuba_scene(mi, gltf, width, height, spp, scratch, materials="lambert"):
         },
     }
     emitters = 0
+    if sky:  # mcrt's --sky with a direct or path estimator: a uniform light at infinity
+        scene["sky"] = {"type": "constant", "radiance": {"type": "rgb", "value": list(sky)}}
+        emitters += 1
     for k, (material, tri) in enumerate(sorted(triangles.items())):
         albedo, emission, double_sided = gltf.material(material)
         bsdf = mitsuba_bsdf(gltf.doc["materials"][material] if material >= 0 else {}, albedo,
@@ -297,6 +314,9 @@ def mitsuba_scene(mi, gltf, width, height, spp, scratch, materials="lambert"):
 
 
 def render(args):
+    # Dr.Jit's LLVM backend needs LLVM 19 (DESIGN.md "Dependencies"): Debian's libllvm19.
+    if args.variant.startswith("llvm") and Path(DEBIAN_LLVM19).exists():
+        os.environ.setdefault("DRJIT_LIBLLVM_PATH", DEBIAN_LLVM19)
     import mitsuba as mi
     mi.set_variant(args.variant)
     gltf = Gltf(args.scene)
@@ -304,6 +324,7 @@ def render(args):
     spp_pass = args.spp // passes
     with tempfile.TemporaryDirectory(prefix="mcrt-mitsuba-") as scratch:
         desc, emitters = mitsuba_scene(mi, gltf, args.width, args.height, spp_pass, scratch,
+                                       args.max_depth, args.rr_depth, args.sky,
                                        args.materials)
         start = time.monotonic()
         scene = mi.load_dict(desc)
@@ -328,7 +349,9 @@ def render(args):
     write_exr(args.out, channels, float_attributes={"spp": spp})
     info = {"scene": str(args.scene), "variant": args.variant, "spp": spp, "passes": passes,
             "width": args.width, "height": args.height, "emitter_shapes": emitters,
-            "integrator": "direct (emitter_samples=1, bsdf_samples=1, MIS)",
+            "integrator": ("direct (emitter_samples=1, bsdf_samples=1, MIS)" if args.max_depth <= 1
+                           else "path (max_depth=%d, rr_depth=%d)" % (args.max_depth + 1,
+                                                                       args.rr_depth)),
             "seconds_render": sum(seconds), "seconds_first_pass": seconds[0],
             "seconds_load": seconds_load, "mitsuba_version": mi.__version__,
             "image_mean": float(mean.mean()),
@@ -394,7 +417,7 @@ def compare(mitsuba_rgb, mitsuba_var, mcrt_path, png_path):
         axes[0].imshow(srgb(mcrt_rgb), interpolation="nearest")
         axes[0].set_title("mcrt", fontsize=8)
         axes[1].imshow(srgb(mitsuba_rgb), interpolation="nearest")
-        axes[1].set_title("Mitsuba 3 direct", fontsize=8)
+        axes[1].set_title("Mitsuba 3", fontsize=8)
         im = axes[2].imshow(z, cmap="RdBu_r", vmin=-4, vmax=4, interpolation="nearest")
         axes[2].set_title("(mcrt − Mitsuba) / combined σ, mean of RGB", fontsize=8)
         fig.colorbar(im, ax=axes[2], fraction=0.046, pad=0.02).ax.tick_params(labelsize=6)
@@ -462,6 +485,12 @@ def main():
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--materials", choices=["lambert", "gltf"], default="lambert",
                    help="how surfaces are converted (see materials above; default lambert)")
+    p.add_argument("--max-depth", type=int, default=1,
+                   help="reflections, as mcrt's --max-depth: 1 is `direct`, N > 1 `path` with "
+                   "max_depth N + 1")
+    p.add_argument("--rr-depth", type=int, default=5, help="with --max-depth > 1: `path`'s rr_depth")
+    p.add_argument("--sky", type=lambda t: [float(x) for x in (t.split(",") * 3)[:3]],
+                   help="R,G,B (or one value): a `constant` emitter, as mcrt's --sky light")
     p.add_argument("--compare", help="an mcrt EXR of the same size to compare with")
     p.add_argument("--diff-png", help="with --compare: write the difference image here")
     p.add_argument("--equal-time", metavar="REF.exr",

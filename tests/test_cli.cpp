@@ -276,6 +276,28 @@ TEST_CASE("bad usage exits 2 with one error line and writes nothing", "[cli]") {
         {"replicates 3", render({"--replicates", "3"}), {"--replicates", "3"}},
         {"replicates not dividing spp", render({"--replicates", "8", "--spp", "12"}), {"--replicates", "12"}},
         {"replicates 32", render({"--replicates", "32"}), {"--replicates"}},
+        {"max depth beyond the bound", render({"--max-depth", "1025"}), {"--max-depth"}},
+        {"max depth -1", render({"--max-depth", "-1"}), {"--max-depth"}},
+        {"rr depth 0", render({"--rr-depth", "0"}), {"--rr-depth"}},
+        {"ambient estimator with paths", render({"--estimator", "ambient-cosine", "--max-depth", "2"}),
+         {"--max-depth", "ambient-cosine"}},
+        {"look-from without look-at", render({"--look-from", "0,1,2"}), {"--look-at"}},
+        {"look-at without look-from", render({"--look-at", "0,1,2"}), {"--look-from"}},
+        {"fov without look-from", render({"--fov", "30"}), {"--look-from"}},
+        {"look-from with two values", render({"--look-from", "0,1", "--look-at", "0,0,0"}), {"--look-from"}},
+        {"look-from not a number", render({"--look-from", "a,b,c", "--look-at", "0,0,0"}), {"--look-from"}},
+        {"look-from nan", render({"--look-from", "nan,0,0", "--look-at", "0,0,0"}), {"--look-from"}},
+        {"look-from equal to look-at", render({"--look-from", "1,2,3", "--look-at", "1,2,3"}),
+         {"--look-at", "--look-from"}},
+        {"up parallel to the view", render({"--look-from", "0,5,0", "--look-at", "0,0,0", "--up", "0,1,0"}),
+         {"--up", "parallel"}},
+        {"up zero", render({"--look-from", "0,5,1", "--look-at", "0,0,0", "--up", "0,0,0"}), {"--up"}},
+        {"fov 180", render({"--look-from", "0,1,5", "--look-at", "0,1,0", "--fov", "180"}), {"--fov"}},
+        {"look-from with --camera", render({"--look-from", "0,1,5", "--look-at", "0,1,0", "--camera", "0"}),
+         {"--look-from", "--camera"}},
+        {"bench: up parallel to the view",
+         {"bench", kCornell, "--look-from", "0,5,0", "--look-at", "0,0,0", "--width", "8", "--height", "8"},
+         {"--up", "parallel"}},
     };
     for (const Case& c : cases) {
         Sandbox box;
@@ -296,6 +318,42 @@ TEST_CASE("bad usage exits 2 with one error line and writes nothing", "[cli]") {
         INFO("left behind: " << joined(box.files()));
         CHECK(box.files().empty());
     }
+}
+
+TEST_CASE("path tracing from the command line: depth, roulette, the sky light, a given camera",
+          "[cli][paths]") {
+    Sandbox box;
+    const std::string exr = box.out("x.exr"), stats = box.out("x.json");
+    auto run = [&](std::vector<std::string> extra) {
+        ProcessResult r = box.run(concat(concat({"render", kCornell, "--out", exr, "--stats", stats}, kSmall), extra));
+        INFO(describe(extra) << "\n  stderr: " << r.err);
+        REQUIRE(r.exit_code == 0);
+        return nlohmann::json::parse(read_whole_file(stats));
+    };
+    nlohmann::json direct = run({});
+    CHECK(direct["max_depth"] == 1);
+    CHECK(direct["roulette_share"] == 0.0);
+    nlohmann::json paths = run({"--max-depth", "8", "--rr-depth", "2", "--estimator", "mis"});
+    CHECK(paths["max_depth"] == 8);
+    CHECK(paths["rr_depth"] == 2);
+    CHECK(paths["roulette_share"].get<double>() > 0.0);
+    CHECK(paths["mean_path_length"].get<double>() > direct["mean_path_length"].get<double>());
+    CHECK(paths["rays_per_sample"].get<double>() > direct["rays_per_sample"].get<double>());
+    // Indirect light adds to the box: the ceiling is no longer black.
+    CHECK(paths["image_mean"][0].get<double>() > direct["image_mean"][0].get<double>());
+    // The sky lights nothing inside the closed box but is seen through its open front.
+    nlohmann::json sky = run({"--sky", "0.5", "--look-from", "0,1,6", "--look-at", "0,1,0", "--fov", "60"});
+    CHECK(sky["sky_light"] == true);
+    CHECK(sky["image_mean"][0].get<double>() > 0.0);
+    nlohmann::json black = run({"--look-from", "0,1,6", "--look-at", "0,1,0", "--fov", "60"});
+    CHECK(black["sky_light"] == false);
+    CHECK(sky["image_mean"][0].get<double>() > black["image_mean"][0].get<double>());
+    // bench takes the same camera.
+    ProcessResult bench = box.run({"bench", kCornell, "--look-from", "0,1,6", "--look-at", "0,1,0",
+                                   "--width", "16", "--height", "16", "--rays", "primary", "--repeats", "1"});
+    INFO(bench.err);
+    CHECK(bench.exit_code == 0);
+    CHECK(bench.out.find("--look-from") != std::string::npos);
 }
 
 TEST_CASE("every estimator, light selection and sampler renders from the command line", "[cli]") {

@@ -89,6 +89,30 @@ TEST_CASE("examples/estimators/bsdf_directions.cl renders bsdf's image bit for b
         }
 }
 
+TEST_CASE("an estimator file is called at every vertex of a path: light-area's image bit for bit",
+          "[estimator-file][cli][paths]") {
+    // Depth 6 with roulette and the sky light through the Cornell box's open front: the file's
+    // light strategy samples the sky as the built-in's does, at every vertex with its numbers.
+    TempDir tmp("mcrt-estimator-file-paths");
+    for (const char* sampler : {"independent", "sobol"}) {
+        std::vector<std::string> common = {kCornell, "--width", "32", "--height", "24", "--spp", "32",
+                                           "--sampler", sampler, "--max-depth", "6", "--rr-depth", "2",
+                                           "--sky", "0.3", "--quiet"};
+        std::vector<std::string> builtin = {"render", "--out", tmp / "builtin.exr", "--estimator",
+                                            "light-area"};
+        std::vector<std::string> file = {"render", "--out", tmp / "file.exr", "--estimator-file",
+                                         kLightArea};
+        builtin.insert(builtin.end(), common.begin(), common.end());
+        file.insert(file.end(), common.begin(), common.end());
+        INFO(sampler);
+        REQUIRE(run_mcrt(tmp, builtin).exit_code == 0);
+        REQUIRE(run_mcrt(tmp, file).exit_code == 0);
+        Image a = read_exr(tmp / "builtin.exr"), b = read_exr(tmp / "file.exr");
+        CHECK(same_bits(a.rgb, b.rgb));
+        CHECK(same_bits(a.variance, b.variance));
+    }
+}
+
 TEST_CASE("a build error in an estimator file names FILE:LINE, exits 2 and writes nothing",
           "[estimator-file][cli]") {
     TempDir tmp("mcrt-estimator-file");

@@ -221,6 +221,35 @@ TEST_CASE("mpirun -n 3 renders the image of one process, bit for bit, every rank
     CHECK(stats["ranks"][1]["message_bytes"].get<uint64_t>() > 0);
 }
 
+TEST_CASE("mpirun -n 2 renders the path-traced image of one process under the sky light",
+          "[mpi][cli][paths]") {
+    // Every rank derives --max-depth, --rr-depth, --sky and the --look-from camera from the same
+    // command line; the path records come back in the runs' sums.
+    TempDir dir;
+    const std::vector<std::string> paths = {"--max-depth", "8", "--rr-depth", "2", "--sky", "0.4",
+                                            "--look-from", "0,1,5", "--look-at", "0,1,0",
+                                            "--estimator", "mis"};
+    auto with = [&](std::vector<std::string> extra) {
+        extra.insert(extra.end(), paths.begin(), paths.end());
+        return extra;
+    };
+    ProcessResult one =
+        run_process(MCRT_EXE, render_args(dir / "one.exr", with({"--stats", dir / "one.json"})), dir.path());
+    REQUIRE(one.exit_code == 0);
+    ProcessResult two = run_mpi(2, render_args(dir / "two.exr", with({"--stats", dir / "two.json"})), dir);
+    INFO("stderr: " << two.err);
+    REQUIRE(two.exit_code == 0);
+    Image a = read_exr(dir / "one.exr"), b = read_exr(dir / "two.exr");
+    CHECK(same_bits(a.rgb, b.rgb));
+    CHECK(same_bits(a.variance, b.variance));
+    nlohmann::json sa = nlohmann::json::parse(read_whole_file(dir / "one.json"));
+    nlohmann::json sb = nlohmann::json::parse(read_whole_file(dir / "two.json"));
+    CHECK(sa["rays"] == sb["rays"]);
+    CHECK(sa["mean_path_length"] == sb["mean_path_length"]);
+    CHECK(sa["roulette_share"] == sb["roulette_share"]);
+    CHECK(sb["roulette_share"].get<double>() > 0.0);
+}
+
 TEST_CASE("two ranks of two devices each render the image of one process", "[mpi][cli]") {
     mpirun();
     TempDir dir;

@@ -15,6 +15,7 @@
 #include "image/image.h"
 #include "process_support.h"
 #include "render/renderer.h"
+#include "scene/gltf_import.h"
 
 using namespace mcrt;
 using namespace mcrt::test;
@@ -95,6 +96,42 @@ TEST_CASE("two devices render the image of one device, bit for bit, both doing w
     CHECK(same_bits(one.image.rgb, fixed.image.rgb));
     CHECK(same_bits(one.image.variance, fixed.image.variance));
     CHECK(fixed.replicates == replicates);
+}
+
+TEST_CASE("paths of depth 8 render bit for bit alike on one device or two and in any batch",
+          "[multidevice][paths]") {
+    Devices devices;
+    Scene scene = load_gltf(kCornell, [](const std::string&) {});
+    RenderSettings settings;
+    settings.width = 24;
+    settings.height = 24;
+    settings.spp = 48;
+    settings.max_depth = 8;
+    settings.rr_depth = 3;
+    GpuSceneData data = make_gpu_scene(scene, build_bvh(scene), scene.cameras.front(),
+                                       settings.width, settings.height);
+    for (const char* estimator : {"mis", "light-area", "hemisphere-cosine"})
+        for (const char* sampler : {"independent", "sobol"}) {
+            settings.estimator = estimator;
+            settings.sampler = sampler;
+            settings.replicates = resolve_replicates(0, settings);
+            settings.batch = 0;
+            INFO(estimator << " / " << sampler);
+            RenderResult one = render(std::vector<const DeviceContext*>{devices.all[0]}, data, settings);
+            RenderResult other = render(std::vector<const DeviceContext*>{devices.all[1]}, data, settings);
+            RenderResult both = render(devices.all, data, settings);
+            settings.batch = 16;
+            RenderResult batched = render(devices.all, data, settings);
+            CHECK(same_bits(one.image.rgb, other.image.rgb));
+            CHECK(same_bits(one.image.rgb, both.image.rgb));
+            CHECK(same_bits(one.image.variance, both.image.variance));
+            CHECK(same_bits(one.image.rgb, batched.image.rgb));
+            CHECK(same_bits(one.image.variance, batched.image.variance));
+            CHECK(one.rays == batched.rays);
+            CHECK(one.path_vertices == batched.path_vertices);
+            CHECK(one.roulette_ends == both.roulette_ends);
+            CHECK(one.roulette_ends > 0);
+        }
 }
 
 TEST_CASE("a device that fails mid-render is retired and the image is unchanged",

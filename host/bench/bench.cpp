@@ -179,7 +179,9 @@ int run_bench(const BenchOptions& o, const std::function<void(const std::string&
 
     Scene scene = load_gltf(o.scene, warn);
     if (scene.triangle_count() == 0) warn(o.scene + ": the scene has no triangles");
-    Camera camera = scene.cameras.empty() ? bench_camera(scene) : scene.cameras.front();
+    Camera camera = o.camera                ? *o.camera
+                    : scene.cameras.empty() ? bench_camera(scene)
+                                            : scene.cameras.front();
     BenchFrame frame = bench_frame(scene);
 
     Bvh bvh = build_bvh(scene, o.bvh);
@@ -291,8 +293,11 @@ int run_bench(const BenchOptions& o, const std::function<void(const std::string&
     }
 
     std::printf("scene %s: %zu triangles, %s camera, %dx%d, device %d: %s\n", o.scene.c_str(),
-                scene.triangle_count(), scene.cameras.empty() ? "bench" : "its first", o.width,
-                o.height, o.device, tracer.info().name.c_str());
+                scene.triangle_count(),
+                o.camera                ? "the --look-from"
+                : scene.cameras.empty() ? "bench"
+                                        : "its first",
+                o.width, o.height, o.device, tracer.info().name.c_str());
     std::printf(
         "mcrt BVH4: built in %.3f s, SAH cost %.2f, depth %d, %zu nodes, %zu packets, %.1f bytes "
         "per triangle\n",

@@ -3,9 +3,11 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "bvh/bvh.h"
+#include "scene/scene.h"
 
 namespace mcrt {
 
@@ -17,6 +19,7 @@ struct BenchOptions {
     int device = 0;     // index from `mcrt devices`
     bool json = false;  // one JSON object per ray kind and line instead of a table
     BvhBuildOptions bvh;  // SAH build options, for experiments with the tree's shape
+    std::optional<Camera> camera;  // --look-from ...: in place of the scene's camera
 };
 
 // Runs the benchmark and prints its results on stdout; returns the exit status. Throws

@@ -7,6 +7,7 @@
 #include "bench/bench.h"
 #include "cl/device.h"
 #include "cl/no_device.h"
+#include "cli/camera_options.h"
 #include "cli/integrate.h"
 #include "cli/messages.h"
 #include "cli/render_command.h"
@@ -31,7 +32,7 @@ int run_devices() {
     return 0;
 }
 
-CLI::App* add_bench_command(CLI::App& app, BenchOptions& o) {
+CLI::App* add_bench_command(CLI::App& app, BenchOptions& o, CameraOptions& look) {
     CLI::App* cmd = app.add_subcommand("bench", "time ray queries on a scene");
     cmd->add_option("scene", o.scene, "glTF scene (.gltf or .glb)")->required();
     cmd->add_option("--rays", o.rays, "ray kind (default: all three)")
@@ -49,6 +50,7 @@ CLI::App* add_bench_command(CLI::App& app, BenchOptions& o) {
         ->capture_default_str()
         ->check(CLI::Range(0, 1 << 30));
     cmd->add_flag("--json", o.json, "one JSON object per ray kind and line");
+    add_camera_options(cmd, look);
     cmd->add_option("--bvh-max-leaf", o.bvh.max_leaf_size, "most triangles in a BVH leaf")
         ->capture_default_str()
         ->check(CLI::Range(1, 64));
@@ -74,7 +76,8 @@ int run_cli(int argc, char** argv) {
     RenderOptions render_options;
     add_render_command(app, render_options);
     BenchOptions bench_options;
-    add_bench_command(app, bench_options);
+    CameraOptions bench_look;
+    add_bench_command(app, bench_options, bench_look);
     IntegrateOptions integrate_options;
     add_integrate_command(app, integrate_options);
 
@@ -99,7 +102,10 @@ int run_cli(int argc, char** argv) {
         }
         if (app.got_subcommand("render")) return run_render(render_options);
         if (app.got_subcommand("integrate")) return run_integrate(integrate_options);
-        if (app.got_subcommand("bench")) return run_bench(bench_options, print_warning);
+        if (app.got_subcommand("bench")) {
+            bench_options.camera = look_at_camera(bench_look);
+            return run_bench(bench_options, print_warning);
+        }
     } catch (const InputError& e) {
         std::cerr << "mcrt: error: " << e.what() << std::endl;
         return 2;

@@ -103,8 +103,15 @@ RenderSettings render_settings(const RenderOptions& o, const std::string* estima
     settings.sampler = o.sampler;
     settings.mis_heuristic = o.mis_heuristic;
     settings.materials = o.materials;
-    settings.sky = parse_sky(o.sky);
+    // The ambient estimators' sky is 1 unless given; for the others --sky makes it a light.
+    const unsigned uses =
+        o.estimator_file.empty() ? estimator_variant(o.estimator).uses : kUserEstimatorUses;
+    settings.sky = o.sky.empty() ? glm::vec3(uses & kUsesSky ? 1.0f : 0.0f) : parse_sky(o.sky);
+    settings.sky_light = (uses & kUsesSkyLight) && !o.sky.empty() &&
+                         (settings.sky.r > 0 || settings.sky.g > 0 || settings.sky.b > 0);
     settings.ao_distance = o.ao_distance;
+    settings.max_depth = o.max_depth;
+    settings.rr_depth = o.rr_depth;
     settings.seed = o.seed;
     settings.batch = o.batch;
     settings.replicates = resolve_replicates(o.replicates, settings);
@@ -117,6 +124,7 @@ void apply_materials_option(Scene& scene, const RenderSettings& settings) {
 }
 
 Camera render_camera(const Scene& scene, const RenderOptions& o) {
+    if (std::optional<Camera> look = look_at_camera(o.look)) return *look;
     if (o.camera >= 0) {
         if (size_t(o.camera) >= scene.cameras.size())
             throw InputError("--camera " + std::to_string(o.camera) + ": " + o.scene + " has " +
@@ -164,14 +172,26 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
         ->capture_default_str()
         ->check(CLI::IsMember(variant_names(kMaterialVariants)));
     cmd->add_option("--seed", o.seed, "random seed")->capture_default_str();
-    cmd->add_option("--sky", o.sky, "sky radiance R,G,B (ambient estimators)")
-        ->capture_default_str();
+    cmd->add_option("--sky", o.sky,
+                    "uniform sky radiance R,G,B: the ambient estimators' sky (default 1), or a "
+                    "light at infinity for the others (default: none, black)");
+    cmd->add_option("--max-depth", o.max_depth,
+                    "reflections per path: 1 direct lighting, 0 emitted light only, up to " +
+                        std::to_string(MCRT_MAX_PATH_DEPTH) + " path tracing")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, MCRT_MAX_PATH_DEPTH));
+    cmd->add_option("--rr-depth", o.rr_depth,
+                    "Russian roulette decides whether a path goes on past its k-th reflection for "
+                    "every k >= this")
+        ->capture_default_str()
+        ->check(CLI::Range(1u, MCRT_MAX_PATH_DEPTH));
     cmd->add_option("--ao-distance", o.ao_distance, "ambient occlusion distance, 0 = unbounded")
         ->capture_default_str()
         ->check(kFinite)
         ->check(CLI::Range(0.0f, 3.4e38f));
-    cmd->add_option("--camera", o.camera, "camera index in the scene")
-        ->check(CLI::Range(0, 1 << 30));
+    CLI::Option* camera = cmd->add_option("--camera", o.camera, "camera index in the scene")
+                              ->check(CLI::Range(0, 1 << 30));
+    add_camera_options(cmd, o.look, camera);
     cmd->add_option("--device", o.devices, "device index, cpu, gpu or all (repeatable)");
     cmd->add_option("--batch", o.batch, "samples per pixel per launch (0 chooses)")
         ->capture_default_str()
@@ -207,6 +227,7 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     if (!o.estimator_file.empty()) inputs.push_back(o.estimator_file);
     check_outputs(outputs, inputs);
     RenderSettings settings = render_settings(o);
+    look_at_camera(o.look);  // a bad --look-from ... is refused before the scene loads
 
     FileBundle files;  // what the other ranks load the scene from
     Scene scene = load_gltf(o.scene, print_warning, &inputs, job ? &files : nullptr);
@@ -217,8 +238,9 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     if (scene.triangle_count() == 0) print_warning(o.scene + ": the scene has no triangles");
     unsigned uses =
         o.estimator_file.empty() ? estimator_variant(o.estimator).uses : kUserEstimatorUses;
-    if ((uses & kUsesLights) && collect_emitters(scene).empty())
-        print_warning(o.scene + ": no emissive triangles: direct lighting is black");
+    if ((uses & kUsesLights) && !settings.sky_light && collect_emitters(scene).empty())
+        print_warning(o.scene + ": no emissive triangles: direct lighting is black" +
+                      (uses & kUsesSkyLight ? " (--sky R,G,B adds a sky light)" : ""));
     Camera camera = render_camera(scene, o);
     if (job) {
         job->share_inputs(files, settings.estimator_source);

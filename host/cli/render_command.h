@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/camera_options.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
 
@@ -19,9 +20,11 @@ struct RenderOptions {
     std::string light_select = "power", sampler = "independent", mis_heuristic = "balance";
     std::string materials = "gltf";
     uint32_t seed = 0;
-    std::string sky = "1";
+    std::string sky;  // "": not given (the ambient estimators' sky is 1, the others have none)
     float ao_distance = 0.0f;
+    uint32_t max_depth = 1, rr_depth = 5;
     int camera = -1;
+    CameraOptions look;  // --look-from ...: replaces the scene's camera
     std::vector<std::string> devices;
     uint32_t batch = 0;
     uint32_t replicates = 0;  // 0: the default (resolve_replicates)

@@ -46,6 +46,10 @@ void Accumulator::apply(const BatchResult& r) {
                 row_n_ = n;  // the same for every pixel of a row: its chunk, over K
                 row_nan_ += uint64_t(s.shift.w);
                 row_rays_ += uint64_t(s.sum.w);
+                // Path vertices + 2^15 × roulette ends (kernels/shared_types.h).
+                const uint64_t path = uint64_t(s.exponent.w);
+                row_vertices_ += path & 0x7fff;
+                row_roulette_ += path >> 15;
             }
         }
         row_pixels_ += item.pixel_count();
@@ -64,7 +68,9 @@ void Accumulator::commit_row() {
     n_ = n;
     nan_samples_ += row_nan_;
     rays_ += row_rays_;
-    row_nan_ = row_rays_ = 0;
+    path_vertices_ += row_vertices_;
+    roulette_ends_ += row_roulette_;
+    row_nan_ = row_rays_ = row_vertices_ = row_roulette_ = 0;
     row_pixels_ = 0;
     ++committed_chunks_;
 }

@@ -37,6 +37,8 @@ public:
     Image image(int width, int height) const;
     uint64_t nan_samples() const { return nan_samples_; }
     uint64_t rays() const { return rays_; }
+    uint64_t path_vertices() const { return path_vertices_; }
+    uint64_t roulette_ends() const { return roulette_ends_; }
     uint32_t replicates() const { return replicates_; }
     uint64_t variance_clamped() const { return variance_clamped_; }
 
@@ -54,9 +56,9 @@ private:
     std::vector<double> row_mean_, row_m2_;
     double row_n_ = 0;          // samples per replicate in the row's runs
     uint32_t row_pixels_ = 0;   // pixels of that row applied so far
-    uint64_t row_nan_ = 0, row_rays_ = 0;
+    uint64_t row_nan_ = 0, row_rays_ = 0, row_vertices_ = 0, row_roulette_ = 0;
     uint32_t committed_chunks_ = 0;
-    uint64_t nan_samples_ = 0, rays_ = 0;
+    uint64_t nan_samples_ = 0, rays_ = 0, path_vertices_ = 0, roulette_ends_ = 0;
     mutable uint64_t variance_clamped_ = 0;
 };
 

@@ -130,7 +130,8 @@ BatchResult DeviceWorker::run(const WorkItem& item) {
                       __FILE__, __LINE__);
 
     gpu::RenderParams params{};
-    params.sky = {settings_.sky.r, settings_.sky.g, settings_.sky.b, 0.0f};
+    params.sky = {settings_.sky.r, settings_.sky.g, settings_.sky.b,
+                  sky_light_pmf(settings_, buffers_->light_count)};
     params.ao_distance = settings_.ao_distance;
     params.width = uint32_t(settings_.width);
     params.height = uint32_t(settings_.height);
@@ -142,6 +143,8 @@ BatchResult DeviceWorker::run(const WorkItem& item) {
     params.sample_begin = sample_begin;
     params.batch_samples = n;
     params.replicates = settings_.replicates;
+    params.max_depth = settings_.max_depth;
+    params.rr_depth = settings_.rr_depth;
     CL_CHECK(render_.setArg(gpu::RENDER_ARG_PARAMS, sizeof params, &params));
     const cl_uint chunks = item.chunk_count();
     const uint64_t runs = uint64_t(item.pixel_count()) * chunks * settings_.replicates;

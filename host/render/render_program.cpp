@@ -9,16 +9,35 @@
 #include "common/error.h"
 #include "render/renderer.h"
 #include "render/variants.h"
+#include "shared_types.h"
 
 namespace mcrt {
+
+float sky_light_pmf(const RenderSettings& settings, uint32_t light_count) {
+    if (!settings.sky_light) return 0.0f;
+    return light_count > 0 ? 0.5f : 1.0f;
+}
 
 std::string render_program_options(const RenderSettings& settings, bool microfacet) {
     std::string options = "-cl-std=CL1.2";
     unsigned uses = kUserEstimatorUses;
+    if (settings.max_depth > MCRT_MAX_PATH_DEPTH)
+        throw InputError("--max-depth " + std::to_string(settings.max_depth) + ": at most " +
+                         std::to_string(MCRT_MAX_PATH_DEPTH));
+    if (settings.rr_depth < 1 || settings.rr_depth > MCRT_MAX_PATH_DEPTH)
+        throw InputError("--rr-depth " + std::to_string(settings.rr_depth) + ": expected 1 .. " +
+                         std::to_string(MCRT_MAX_PATH_DEPTH));
     if (settings.estimator_file.empty()) {
         const EstimatorVariant& estimator = estimator_variant(settings.estimator);
         options += std::string(" -D MCRT_ESTIMATE=") + estimator.function;
         uses = estimator.uses;
+        // The ambient estimators integrate sky visibility, not reflected light: no path to extend.
+        if ((uses & kUsesSky) && settings.max_depth > 1)
+            throw InputError("--max-depth " + std::to_string(settings.max_depth) +
+                             ": --estimator " + settings.estimator +
+                             " is an ambient estimator (sky visibility, one bounce): --max-depth "
+                             "0 or 1; path tracing under the sky is --sky R,G,B with light-area, "
+                             "light-solid-angle, bsdf, hemisphere-* or mis");
         if (uses & kUsesSky) options += " -D ESTIMATOR_USES_SKY";
     } else {
         options += std::string(" -D MCRT_ESTIMATE=") + kUserEstimatorFunction;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <CL/opencl.hpp>
+#include <cstdint>
 #include <string>
 
 #include "cl/device.h"
@@ -15,6 +16,11 @@ struct RenderSettings;
 // The -D options of the render program (throws InputError for a name no table has);
 // `microfacet`: the scene has a surface that is not Lambertian (GpuSceneData::microfacet).
 std::string render_program_options(const RenderSettings& settings, bool microfacet = false);
+
+// Probability that the light strategies choose the sky light (RenderParams::sky.w): 0 when the
+// sky is no light, 1 when it is the only one, else 1/2 beside the area lights, the exact split of
+// the selection sample (kernels/light_sampling.cl, select_sky).
+float sky_light_pmf(const RenderSettings& settings, uint32_t light_count);
 
 // The user's estimator file, if any, as the replacement of kernels/user_estimator.cl.
 KernelReplacements render_program_replacements(const RenderSettings& settings);

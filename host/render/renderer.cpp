@@ -156,6 +156,8 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
     result.replicates = acc.replicates();
     result.variance_clamped = acc.variance_clamped();
     result.rays = acc.rays();
+    result.path_vertices = acc.path_vertices();
+    result.roulette_ends = acc.roulette_ends();
     result.devices = device_reports();
     for (const DeviceReport& d : result.devices) result.seconds_render += d.seconds_busy;
     return result;

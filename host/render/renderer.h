@@ -27,8 +27,11 @@ struct RenderSettings {
     std::string sampler = "independent";   // kSamplerVariants
     std::string mis_heuristic = "balance"; // kMisHeuristicVariants
     std::string materials = "gltf";        // kMaterialVariants (the scene is read accordingly)
-    glm::vec3 sky{1.0f};        // ambient estimators: uniform sky radiance
+    glm::vec3 sky{1.0f};        // ambient estimators: uniform sky radiance; else the sky light's
+    bool sky_light = false;     // direct and path estimators: the sky is a light (--sky given)
     float ao_distance = 0.0f;   // ambient estimators: occlusion range, 0 = unbounded
+    uint32_t max_depth = 1;     // reflections per path, 0 .. MCRT_MAX_PATH_DEPTH; 1: direct light
+    uint32_t rr_depth = 5;      // Russian roulette before reflection k + 1 for every k >= rr_depth
     uint32_t seed = 0;
     uint32_t batch = 0;  // samples per pixel per launch; 0 chooses; rounded up to whole chunks
     // Independent randomizations of the sampler the variance layer is estimated from (1: the
@@ -59,6 +62,8 @@ struct RenderResult {
     std::string stopped_by;      // "", "time limit" or "interrupt"
     uint64_t nan_samples = 0;    // non-finite samples, left out of the image
     uint64_t rays = 0;           // camera and shadow rays traced
+    uint64_t path_vertices = 0;  // surface points the paths reached (the camera's hit included)
+    uint64_t roulette_ends = 0;  // paths that Russian roulette ended
     double seconds_render = 0;   // kernel time summed over devices (profiling events)
     double seconds_build = 0;    // kernel compilation and scene upload
     std::vector<DeviceReport> devices;

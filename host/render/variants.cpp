@@ -8,21 +8,22 @@ namespace mcrt {
 
 // DESIGN.md "Estimators"; the kernel functions are in kernels/estimators.cl.
 const std::vector<EstimatorVariant> kEstimatorVariants = {
-    {"hemisphere-uniform", "estimate_hemisphere_uniform", kUsesLights,
+    {"hemisphere-uniform", "estimate_hemisphere_uniform", kUsesLights | kUsesSkyLight,
      "directions uniform on the hemisphere, pdf 1/(2 pi), counting the emitters they hit (GI "
      "Compendium eq. 34)"},
-    {"hemisphere-cosine", "estimate_hemisphere_cosine", kUsesLights,
+    {"hemisphere-cosine", "estimate_hemisphere_cosine", kUsesLights | kUsesSkyLight,
      "cosine-weighted directions, pdf cos/pi, counting the emitters they hit (eq. 35)"},
-    {"bsdf", "estimate_bsdf", kUsesLights | kUsesBsdfSampling,
+    {"bsdf", "estimate_bsdf", kUsesLights | kUsesBsdfSampling | kUsesSkyLight,
      "directions by the BSDF's sampling density (cosine for Lambertian, GGX visible normals for "
      "glossy lobes), counting the emitters they hit"},
-    {"light-area", "estimate_light_area", kUsesLights | kUsesLightSelection,
+    {"light-area", "estimate_light_area", kUsesLights | kUsesLightSelection | kUsesSkyLight,
      "a light by --light-select and a uniform point on it, pdf pmf/area converted by cos_y/d^2"},
-    {"light-solid-angle", "estimate_light_solid_angle", kUsesLights | kUsesLightSelection,
+    {"light-solid-angle", "estimate_light_solid_angle",
+     kUsesLights | kUsesLightSelection | kUsesSkyLight,
      "a light by --light-select and a direction uniform in its spherical triangle (Arvo 1995), "
      "area below 3e-4 sr"},
     {"mis", "estimate_mis",
-     kUsesLights | kUsesLightSelection | kUsesMisHeuristic | kUsesBsdfSampling,
+     kUsesLights | kUsesLightSelection | kUsesMisHeuristic | kUsesBsdfSampling | kUsesSkyLight,
      "one light-area and one BSDF-sampled direction, weighted by --mis-heuristic (Veach 1997)"},
     {"ambient-uniform", "estimate_ambient_uniform", kUsesSky,
      "ambient light: sky visibility over uniform directions, albedo x L_sky x (1/pi) int V cos"},
@@ -112,6 +113,7 @@ std::vector<std::string> uses_names(unsigned uses) {
     if (uses & kUsesMisHeuristic) names.push_back("mis-heuristic");
     if (uses & kUsesBsdfSampling) names.push_back("bsdf-sampling");
     if (uses & kUsesCorrelatedSamples) names.push_back("correlated-samples");
+    if (uses & kUsesSkyLight) names.push_back("sky-light");
     return names;
 }
 

@@ -20,6 +20,8 @@ enum EstimatorUses : unsigned {
     kUsesBsdfSampling = 1u << 4,  // draws directions from the BSDF
     kUsesCorrelatedSamples = 1u << 5,  // a pixel's samples are correlated whatever the sampler
                                        // (the Fibonacci spiral): error bars need replicates
+    kUsesSkyLight = 1u << 6,  // with --sky, sees the sky as a light at infinity (its directions
+                              // that escape, the light strategies' sky samples); paths
 };
 
 struct EstimatorVariant {
@@ -61,9 +63,11 @@ std::vector<std::string> variant_names(const std::vector<OptionVariant>& table);
 std::vector<std::string> uses_names(unsigned uses);
 
 // What a user's --estimator-file is assumed to use: lights, their selection and the MIS
-// heuristic (it may call mis_weight); the sky only when the file defines ESTIMATOR_USES_SKY
+// heuristic (it may call mis_weight), the sky light (through the light strategies and
+// environment_radiance); the ambient sky only when the file defines ESTIMATOR_USES_SKY
 // (docs/ESTIMATORS.md).
-constexpr unsigned kUserEstimatorUses = kUsesLights | kUsesLightSelection | kUsesMisHeuristic;
+constexpr unsigned kUserEstimatorUses =
+    kUsesLights | kUsesLightSelection | kUsesMisHeuristic | kUsesSkyLight;
 
 // The function a user's estimator file defines.
 constexpr const char* kUserEstimatorFunction = "estimate";

@@ -1,0 +1,106 @@
+/* Paths: the chosen estimator as next-event estimation at every vertex, the path going on by
+ * sampling the BSDF (PBRT 3rd ed. 14.5; Veach 1997, sec. 10.4). One work-item traces one whole
+ * path; its random numbers are those of the vertex it is at (rng.cl, stream_dimension). */
+#ifndef MCRT_PATH_CL
+#define MCRT_PATH_CL
+
+#include "api.cl"
+
+#if !defined(MCRT_ESTIMATE)
+#error "no estimator selected: the host defines MCRT_ESTIMATE (host/render/variants.cpp)"
+#endif
+
+/* Russian roulette keeps a path with probability min(max channel of its throughput, 0.95), as
+ * Mitsuba 3's path integrator does, and divides the survivors by it: unbiased (PBRT 3rd ed.
+ * 13.7), and even a bright path ends eventually. */
+#define MCRT_RR_MAX_SURVIVAL 0.95f
+
+inline float max_component(float3 v) { return fmax(v.x, fmax(v.y, v.z)); }
+
+/* True when the memo holds the ray from sp along wi, bit for bit: the estimator traced the
+ * continuation already (its BSDF or cosine direction from the same numbers). */
+inline bool memo_holds(const TraceMemo* memo, const SurfacePoint* sp, float3 wi) {
+    float3 o = offset_ray_origin(sp->p, sp->n);
+    return memo->valid && all(as_uint3(memo->origin) == as_uint3(o)) &&
+           all(as_uint3(memo->wi) == as_uint3(wi));
+}
+
+/* What a path did, for the stats: surface vertices it reached, and whether roulette ended it. */
+typedef struct {
+    uint rays;
+    uint vertices;
+    bool roulette;
+} PathRecord;
+
+/* Radiance arriving along camera ray r after at most max_depth reflections: L_e at the first hit,
+ * plus at each vertex k < max_depth the throughput times the estimator's estimate of the light
+ * reflected there directly (its own strategies; emitters that the continuation later finds are
+ * not counted again). The continuation samples the BSDF with the vertex's DIM_DIRECTION numbers,
+ * the ones the BSDF and MIS estimators use, so that their direction is also the path's (as
+ * pbrt's path tracer shares it) and its ray is traced once (TraceMemo). A ray leaving the scene
+ * sees black, or the sky for the ambient estimators (-D ESTIMATOR_USES_SKY) and the sky light
+ * (DESIGN.md "Radiometric contract"). */
+inline float3 path_radiance(const SceneView* scene, const Ray* r, SampleStream* stream,
+                            uint max_depth, uint rr_depth, PathRecord* record) {
+    TraceMemo* memo = scene->memo; /* may be 0 (direct lighting keeps none) */
+    record->rays += 1u;
+    Hit hit = bvh_closest_hit(scene->nodes, scene->packets, r, MAXFLOAT);
+#if defined(ESTIMATOR_USES_SKY)
+    if (hit.lane == MCRT_NO_HIT) return scene->env.sky;
+#else
+    if (hit.lane == MCRT_NO_HIT) return environment_radiance(scene);
+#endif
+    SurfacePoint sp = surface_point(scene, r, &hit);
+    record->vertices = 1u;
+    float3 L = emitted_radiance(&sp);
+    float3 beta = (float3)(1.0f); /* throughput: f·cosθ/pdf along the path so far */
+    for (uint k = 0u; k < max_depth;) {
+        /* Direct light at vertex k, by the estimator's strategies. */
+        stream->vertex = k;
+        if (memo) memo->valid = false;
+        L += beta * MCRT_ESTIMATE(scene, &sp, stream, &record->rays);
+        if (++k == max_depth) break;
+
+        /* Continue by BSDF sampling. */
+        BsdfSample bs = bsdf_sample(&sp, sample_2d(stream, DIM_DIRECTION));
+        if (!(bs.pdf_w > 0.0f) || bs.cos_theta <= 0.0f) break;
+        beta *= bs.f * (bs.cos_theta / bs.pdf_w);
+        if (!(max_component(beta) > 0.0f)) break;
+
+        /* Russian roulette before vertex k, with that vertex's number. */
+        stream->vertex = k;
+        if (k >= rr_depth) {
+            float survive = fmin(max_component(beta), MCRT_RR_MAX_SURVIVAL);
+            if (!(sample_1d(stream, DIM_ROULETTE) < survive)) {
+                record->roulette = true;
+                break;
+            }
+            beta /= survive;
+        }
+
+        SurfacePoint next;
+        if (memo && memo_holds(memo, &sp, bs.wi)) {
+            if (!memo->hit) break;
+            next = memo->seen;
+        } else if (!trace_from(scene, &sp, bs.wi, &record->rays, &next)) {
+            break;
+        }
+        sp = next;
+        record->vertices += 1u;
+    }
+    return L;
+}
+
+/* The record in the 32 bits that render writes beside a sample's radiance (reduce_chunks reads
+ * them): rays in bits 0-19 (saturated), vertices in 20-30 (at most MCRT_MAX_PATH_DEPTH + 1 < 2^11),
+ * roulette in bit 31. */
+#define PATH_RECORD_MAX_RAYS 0xfffffu
+inline uint pack_path_record(const PathRecord* record) {
+    return min(record->rays, PATH_RECORD_MAX_RAYS) | (record->vertices << 20) |
+           (record->roulette ? 0x80000000u : 0u);
+}
+inline uint path_record_rays(uint packed) { return packed & PATH_RECORD_MAX_RAYS; }
+inline uint path_record_vertices(uint packed) { return (packed >> 20) & 0x7ffu; }
+inline uint path_record_roulette(uint packed) { return packed >> 31; }
+
+#endif
