@@ -12,9 +12,13 @@ twins of tests/test_materials.cpp's planes).
                       sampling holds, MIS holds
   dielectric-plane    metallic 0, baseColor (0.6, 0.5, 0.4), roughness 0.2, the default
                       specular layer (F0 0.04): a diffuse base under a sharp highlight
+  cornell-metal-block the Cornell box (scenes/cornell, its .bin shared) with every surface
+                      Lambertian in glTF terms (specularFactor 0) but the tall block, a white
+                      metal of roughness 0.3: glossy paths Mitsuba can render with the same BRDFs
 
 Usage: scripts/make_glossy_scenes.py [OUTPUT_DIR]   (default: scenes/glossy beside this script)
 """
+import json
 from pathlib import Path
 
 from make_stress_scenes import StressScene, X, Z, looking_down, quad, scale
@@ -48,8 +52,35 @@ def dielectric_plane():
                                             "metallicFactor": 0.0, "roughnessFactor": 0.2})
 
 
+class CopiedGltf:
+    """A glTF document written as it is (write(path), as the generators' scenes)."""
+
+    def __init__(self, doc):
+        self.doc = doc
+
+    def write(self, path):
+        path.write_text(json.dumps(self.doc, indent=1) + "\n")
+
+
+def cornell_metal_block():
+    root = Path(__file__).resolve().parent.parent / "scenes"
+    doc = json.loads((root / "cornell" / "CornellBox-Original.gltf").read_text())
+    for b in doc["buffers"]:
+        b["uri"] = "../cornell/" + b["uri"]
+    for m in doc["materials"]:
+        pbr = m.setdefault("pbrMetallicRoughness", {})
+        if m.get("name") == "tallBox":
+            pbr.update({"baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 1.0,
+                        "roughnessFactor": 0.3})
+        else:
+            m.setdefault("extensions", {})["KHR_materials_specular"] = {"specularFactor": 0.0}
+    doc["extensionsUsed"] = sorted(set(doc.get("extensionsUsed", []) + ["KHR_materials_specular"]))
+    doc["asset"]["generator"] = "mcrt scripts/make_glossy_scenes.py from CornellBox-Original.gltf"
+    return CopiedGltf(doc)
+
+
 SCENES = {"white-metal-plane": white_metal_plane, "mirror-plane": mirror_plane,
-          "dielectric-plane": dielectric_plane}
+          "dielectric-plane": dielectric_plane, "cornell-metal-block": cornell_metal_block}
 
 
 def main():
