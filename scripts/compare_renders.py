@@ -7,8 +7,8 @@ kernels or the host must leave unchanged.
         [--size 48] [--spp 32] [--seed 7] [--only mis,light-area]
         [--new-options "--materials lambert"]
 
-The variants come from the new binary's `mcrt variants --json`, less the estimators the old
-one does not have; the old one is given the same command-line names, the new one also
+The variants come from the new binary's `mcrt variants --json`, less the estimators and light
+selections the old one does not have; the old one is given the same command-line names, the new one also
 --new-options. Prints one line per render and exits 1 when any image differs.
 """
 
@@ -28,12 +28,15 @@ from mcrt_exr import read_exr  # noqa: E402
 def renders(args):
     """(label, options) of every combination."""
     table = mcrt_run.variants(args.mcrt)
-    old = set(e["name"] for e in mcrt_run.variants(args.baseline)["estimators"])
+    old_table = mcrt_run.variants(args.baseline)
+    old = set(e["name"] for e in old_table["estimators"])
+    old_names = lambda key: set(r["name"] for r in old_table.get(key, []))  # noqa: E731
     only = set(args.only.split(",")) if args.only else None
     for e in table["estimators"]:
         if (only and e["name"] not in only) or e["name"] not in old:
             continue
-        selections = mcrt_run.names("light_select", mcrt=args.mcrt)
+        selections = [n for n in mcrt_run.names("light_select", mcrt=args.mcrt)
+                      if n in old_names("light_select")]
         heuristics = (mcrt_run.names("mis_heuristics", mcrt=args.mcrt)
                       if "mis-heuristic" in e["uses"] else ["balance"])
         for select in selections:
