@@ -113,5 +113,20 @@ struct PlaneScene {
     }
 };
 
+// The closed furnace: a sphere emitting Le inward and reflecting albedo around the camera, so
+// that every point sees Le in every direction (a path of N reflections sums Le albedo^k).
+struct FurnaceScene {
+    Scene scene;
+    Camera camera = looking_down(glm::vec3(0.1f, 0.2f, 0.0f), glm::radians(90.0f));
+    glm::vec3 Le, albedo;
+
+    explicit FurnaceScene(glm::vec3 Le_ = glm::vec3(0.5f, 1.0f, 2.0f),
+                          glm::vec3 albedo_ = glm::vec3(0.8f, 0.5f, 0.2f), int slices = 24,
+                          int stacks = 12)
+        : Le(Le_), albedo(albedo_) {
+        uint32_t m = add_material(scene, albedo, Le);
+        add_sphere(scene, glm::vec3(0.0f), 1.0f, slices, stacks, m, /*inward=*/true);
+    }
+};
 
 }  // namespace mcrt::test

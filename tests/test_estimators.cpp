@@ -59,11 +59,10 @@ TEST_CASE("in a furnace every estimator is unbiased and the cosine estimator has
     // A sphere emitting Le inward and reflecting with albedo ρ around the camera: every point
     // sees Le in all directions, so a pixel is Le + ρ·Le exactly.
     DeviceContext device = first_device();
-    Scene scene;
-    const glm::vec3 Le(0.5f, 1.0f, 2.0f), albedo(0.8f, 0.5f, 0.2f);
-    uint32_t m = add_material(scene, albedo, Le);
-    add_sphere(scene, glm::vec3(0.0f), 1.0f, 24, 12, m, /*inward=*/true);
-    Camera camera = looking_down(glm::vec3(0.1f, 0.2f, 0.0f), glm::radians(90.0f));
+    const FurnaceScene furnace;
+    const Scene& scene = furnace.scene;
+    const glm::vec3 Le = furnace.Le, albedo = furnace.albedo;
+    const Camera& camera = furnace.camera;
     RenderSettings settings;
     settings.width = 8;
     settings.height = 8;

@@ -49,11 +49,10 @@ TEST_CASE("a closed furnace renders Le (1 - rho^(N+1)) / (1 - rho) at depth N",
     // A sphere emitting Le inward and reflecting ρ around the camera: after k reflections every
     // path still sees Le, so depth N sums Le ρ^k for k = 0 .. N.
     DeviceContext device = first_device();
-    Scene scene;
-    const glm::vec3 Le(0.5f, 1.0f, 2.0f), albedo(0.8f, 0.5f, 0.2f);
-    uint32_t m = add_material(scene, albedo, Le);
-    add_sphere(scene, glm::vec3(0.0f), 1.0f, 24, 12, m, /*inward=*/true);
-    Camera camera = looking_down(glm::vec3(0.1f, 0.2f, 0.0f), glm::radians(90.0f));
+    const FurnaceScene furnace;
+    const Scene& scene = furnace.scene;
+    const glm::vec3 Le = furnace.Le, albedo = furnace.albedo;
+    const Camera& camera = furnace.camera;
     RenderSettings settings;
     settings.width = 8;
     settings.height = 8;

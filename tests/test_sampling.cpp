@@ -15,6 +15,7 @@
 #include "cl/program.h"
 #include "chi2.h"
 #include "device_support.h"
+#include "kernel_program.h"
 #include "render/discrete.h"
 #include "render/light_tree.h"
 
@@ -36,51 +37,10 @@ enum WarpKind : cl_uint { kUniform = 0, kCosine = 1, kSphericalTriangle = 2, kFi
 
 // ---- Device ---------------------------------------------------------------------------------
 
-struct Device {
-    DeviceContext device = first_device();
-    cl::Program program =
-        build_program(device.context, device.info.device, kernel_source("sampling_test.cl"), "");
-
-    template <typename T>
-    cl::Buffer buffer(const std::vector<T>& v) {
-        cl_int status;
-        std::vector<T> copy = v.empty() ? std::vector<T>(1) : v;
-        cl::Buffer b(device.context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
-                     copy.size() * sizeof(T), copy.data(), &status);
-        CL_CHECK_STATUS(status, "clCreateBuffer");
-        return b;
-    }
-
-    template <typename T>
-    cl::Buffer output(size_t n) {
-        cl_int status;
-        cl::Buffer b(device.context, CL_MEM_READ_WRITE, std::max<size_t>(n, 1) * sizeof(T), nullptr,
-                     &status);
-        CL_CHECK_STATUS(status, "clCreateBuffer");
-        return b;
-    }
-
-    template <typename T>
-    std::vector<T> read(const cl::Buffer& b, size_t n) {
-        std::vector<T> out(n);
-        if (n) CL_CHECK(device.queue.enqueueReadBuffer(b, CL_TRUE, 0, n * sizeof(T), out.data()));
-        return out;
-    }
-
-    template <typename... Args>
-    void run(const char* entry, size_t global, const Args&... args) {
-        cl::Kernel k = make_kernel(program, entry);
-        cl_uint index = 0;
-        auto set = [&](const auto& arg) { CL_CHECK(k.setArg(index++, arg)); };
-        (set(args), ...);
-        CL_CHECK(device.queue.enqueueNDRangeKernel(k, cl::NullRange,
-                                                   cl::NDRange(std::max<size_t>(global, 1))));
-        CL_CHECK(device.queue.finish());
-    }
-};
+using Device = KernelProgram;
 
 Device& device() {
-    static Device d;
+    static Device d("sampling_test.cl", "");
     return d;
 }
 
