@@ -75,11 +75,15 @@ inline float gltf_specular_probability(const GltfMaterial* m, float c) {
     return total > 0.0f ? specular / total : 0.5f;
 }
 
-/* The mixture density of the two lobes, local directions (wi above the surface). */
+/* The mixture density of the two lobes, the specular one chosen with probability p; local
+ * directions, wi above the surface. */
+inline float gltf_mixture_pdf_w(const GltfMaterial* m, float p, float3 wo, float3 wi) {
+    return p * ggx_reflection_pdf_w(wo, wi, m->alpha) + (1.0f - p) * wi.z * MCRT_INV_PI;
+}
+
 inline float gltf_pdf_w(const GltfMaterial* m, float3 wo, float3 wi) {
     if (!(wi.z > 0.0f) || !(wo.z > 0.0f)) return 0.0f;
-    float p = gltf_specular_probability(m, wo.z);
-    return p * ggx_reflection_pdf_w(wo, wi, m->alpha) + (1.0f - p) * wi.z * MCRT_INV_PI;
+    return gltf_mixture_pdf_w(m, gltf_specular_probability(m, wo.z), wo, wi);
 }
 
 /* f_r(wo, wi) at sp: 0 unless both directions are on the side of the normal. */
@@ -91,8 +95,9 @@ inline float3 bsdf_eval(const SurfacePoint* sp, float3 wi) {
     return gltf_brdf(&m, wo_l, wi_l);
 }
 
-/* A direction by the BSDF's density: u.x first chooses the lobe and is rescaled to [0, 1) within
- * the choice (as the light selection does, discrete.cl), then (u.x, u.y) samples that lobe.
+/* A direction by the BSDF's density: u.x first chooses the lobe and is rescaled linearly to
+ * [0, 1) within the choice (one number for the choice and the direction), then (u.x, u.y)
+ * samples that lobe.
  * f and pdf_w are those of the whole BSDF (both lobes); a specular sample reflected below the
  * surface is returned with pdf_w = 0 (no direction: the estimators skip it). */
 inline BsdfSample bsdf_sample(const SurfacePoint* sp, float2 u) {
@@ -119,7 +124,7 @@ inline BsdfSample bsdf_sample(const SurfacePoint* sp, float2 u) {
     wi = normalize(wi);
     s.wi = frame_to_world(&frame, wi);
     s.f = gltf_brdf(&m, wo, wi);
-    s.pdf_w = p * ggx_reflection_pdf_w(wo, wi, m.alpha) + (1.0f - p) * wi.z * MCRT_INV_PI;
+    s.pdf_w = gltf_mixture_pdf_w(&m, p, wo, wi);
     s.cos_theta = wi.z;
     return s;
 }
