@@ -113,6 +113,17 @@ std::thread signal_rank_later(const std::string& marker, int rank, int signal, d
     });
 }
 
+// The 64×64 Cornell box of `spp` samples rendered by one process into dir/full.exr: what an
+// MPI render stopped after spp samples must equal bit for bit.
+Image one_process_render(const TempDir& dir, uint32_t spp) {
+    ProcessResult r = run_process(MCRT_EXE,
+                                  {"render", kCornell, "--width", "64", "--height", "64", "--spp",
+                                   std::to_string(spp), "--quiet", "--out", dir / "full.exr"},
+                                  dir.path(), 120);
+    REQUIRE(r.exit_code == 0);
+    return read_exr(dir / "full.exr");
+}
+
 }  // namespace
 
 TEST_CASE("MPI messages: inputs, hellos, items and results read back as written", "[mpi]") {
@@ -358,13 +369,7 @@ TEST_CASE(
         CHECK(img.spp == spp);
         CHECK(stats["ranks"][1]["samples"].get<uint64_t>() > 0);
         // Exactly the render of spp samples by one process.
-        ProcessResult again =
-            run_process(MCRT_EXE,
-                        {"render", kCornell, "--width", "64", "--height", "64", "--spp",
-                         std::to_string(spp), "--quiet", "--out", dir / "full.exr"},
-                        dir.path(), 120);
-        REQUIRE(again.exit_code == 0);
-        CHECK(same_bits(img.rgb, read_exr(dir / "full.exr").rgb));
+        CHECK(same_bits(img.rgb, one_process_render(dir, spp).rgb));
     }
 }
 
@@ -435,11 +440,5 @@ TEST_CASE(
     CHECK(stats["stopped_by"] == "time limit");
     CHECK(stats["ranks"][1]["devices_retired"] == 1);
     REQUIRE(spp > 0);
-    ProcessResult again =
-        run_process(MCRT_EXE,
-                    {"render", kCornell, "--width", "64", "--height", "64", "--spp",
-                     std::to_string(spp), "--quiet", "--out", dir / "full.exr"},
-                    dir.path(), 120);
-    REQUIRE(again.exit_code == 0);
-    CHECK(same_bits(read_exr(dir / "recovered.exr").rgb, read_exr(dir / "full.exr").rgb));
+    CHECK(same_bits(read_exr(dir / "recovered.exr").rgb, one_process_render(dir, spp).rgb));
 }
