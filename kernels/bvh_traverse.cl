@@ -121,20 +121,16 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePa
                 float4 t4, b1, b2;
                 int4 lanes = intersect_packet(&q, pk, hit.t, &t4, &b1, &b2);
                 if (!any(lanes)) continue;
-                int m[4];
-                float t[4], u[4], v[4];
-                vstore4(lanes, 0, m);
-                vstore4(t4, 0, t);
-                vstore4(b1, 0, u);
-                vstore4(b2, 0, v);
-                for (int i = 0; i < 4; ++i) {
-                    if (m[i] && t[i] < hit.t) {
-                        hit.t = t[i];
-                        hit.b1 = u[i];
-                        hit.b2 = v[i];
-                        hit.lane = MCRT_PACKET_WIDTH * (ref + k / MCRT_PACKET_WIDTH) + i;
-                    }
-                }
+                /* The nearest hit lane, the first of equals (leaf order, as one triangle at a time
+                 * would take them), by compares instead of a loop over private arrays. */
+                float4 tm = select((float4)(MAXFLOAT), t4, lanes);
+                float2 m2 = min(tm.xy, tm.zw);
+                float m = min(m2.x, m2.y);
+                int i = tm.x == m ? 0 : tm.y == m ? 1 : tm.z == m ? 2 : 3;
+                hit.t = m;
+                hit.b1 = i == 0 ? b1.x : i == 1 ? b1.y : i == 2 ? b1.z : b1.w;
+                hit.b2 = i == 0 ? b2.x : i == 1 ? b2.y : i == 2 ? b2.z : b2.w;
+                hit.lane = MCRT_PACKET_WIDTH * (ref + k / MCRT_PACKET_WIDTH) + (uint)i;
             }
         }
         /* Pop, skipping children entered beyond the closest hit found since they were pushed. */

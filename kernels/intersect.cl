@@ -43,9 +43,13 @@ inline PacketRay make_packet_ray(const Ray* r) {
  * shear (sec. 3); scaled barycentrics as 2D edge functions, recomputed in double when one is an
  * exact zero, which may be a rounding artefact on a shared edge; the scaled hit distance compared
  * before dividing. Returns a lane mask (-1 where a used lane is hit with t in (0, t_max)) and the
- * lanes' t and barycentrics b1, b2 of vertices 1 and 2. */
-inline int4 intersect_packet(const PacketRay* q, global const TrianglePacket* pk, float t_max,
-                             float4* t_hit, float4* b1, float4* b2) {
+ * lanes' t and barycentrics b1, b2 of vertices 1 and 2. Forced inline: PoCL's inliner prices it
+ * just over its threshold (565 against 562) and called it, which cost the closest hit about 10%
+ * (docs/BENCHMARKS.md, issue 16). */
+inline __attribute__((always_inline)) int4 intersect_packet(const PacketRay* q,
+                                                            global const TrianglePacket* pk,
+                                                            float t_max, float4* t_hit,
+                                                            float4* b1, float4* b2) {
     global const float4* v = pk->v;
     float4 a_x = v[q->kx] - q->org_x, a_y = v[q->ky] - q->org_y, a_z = v[q->kz] - q->org_z;
     float4 b_x = v[3u + q->kx] - q->org_x, b_y = v[3u + q->ky] - q->org_y,

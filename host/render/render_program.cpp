@@ -1,6 +1,7 @@
 #include "render/render_program.h"
 
 #include <cctype>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -53,6 +54,10 @@ std::string render_program_options(const RenderSettings& settings, bool microfac
     const OptionVariant& materials =
         option_variant(kMaterialVariants, settings.materials, "--materials");
     if (microfacet && materials.macro) options += std::string(" -D ") + materials.macro;
+    // Development override, as MCRT_KERNEL_DIR is for the sources: extra build options, e.g.
+    // the -D switches of scripts/profile_stages.py (docs/BENCHMARKS.md, issue 16).
+    if (const char* extra = std::getenv("MCRT_KERNEL_OPTIONS"); extra && *extra)
+        options += std::string(" ") + extra;
     return options;
 }
 
