@@ -102,17 +102,13 @@ cl::Program cached_program(const DeviceContext& device, const std::string& file,
     std::lock_guard<std::mutex> lock(mutex);
     auto it = programs.find(key);
     if (it != programs.end()) return it->second;
-    // Across processes, the on-disk binary cache skips compilation on drivers without their own.
-    // PoCL caches compiled kernels itself (unless POCL_KERNEL_CACHE=0), and asking it for the
-    // binary costs a full code generation (~0.5 s per variant, docs/BENCHMARKS.md): skip it there.
-    const char* pocl_cache = std::getenv("POCL_KERNEL_CACHE");
-    bool driver_caches = device.info.platform_name.find("Portable Computing Language") !=
-                             std::string::npos &&
-                         !(pocl_cache && std::string(pocl_cache) == "0");
-    cl::Program program =
-        driver_caches ? build_program(device.context, device.info.device, source, options)
-                      : build_program_cached(device.context, device.info.device, device.info,
-                                             source, options);
+    // Across processes, the on-disk binary cache skips compilation. On PoCL too, although PoCL
+    // caches compiled kernels itself: its cache hit still preprocesses and hashes the source
+    // (0.05-0.09 s of a 0.15 s start), a binary hit does not (start to first sample 0.13 ->
+    // 0.06-0.07 s, docs/BENCHMARKS.md, issue 16). A miss costs PoCL a code generation for the
+    // binary (about 1 s per variant, once).
+    cl::Program program = build_program_cached(device.context, device.info.device, device.info,
+                                               source, options);
     programs.emplace(key, program);
     return program;
 }

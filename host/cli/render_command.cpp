@@ -264,6 +264,8 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     control.interrupted = &g_interrupted;
     InterruptGuard interrupt_guard;  // SIGINT / SIGTERM: stop and write what is done
     ProgressBar bar(!o.quiet, uint64_t(o.width) * o.height);
+    const double seconds_to_render =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     RenderResult result = render(
         device_list, gpu_scene, settings,
         [&](uint32_t done, uint32_t total, const std::vector<DeviceReport>& d) {
@@ -299,7 +301,8 @@ int render_here(const RenderOptions& o, RenderJob* job) {
 
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!o.stats.empty()) {
-        nlohmann::json j = render_stats_json({o, settings, scene, bvh, gpu_scene, result, total});
+        nlohmann::json j = render_stats_json(
+            {o, settings, scene, bvh, gpu_scene, result, total, seconds_to_render});
         if (job) j["ranks"] = job->ranks_json(result.devices);
         write_atomically(o.stats, [&](const std::string& tmp) {
             std::ofstream out(tmp);

@@ -19,6 +19,7 @@ struct RenderStatsInput {
     const GpuSceneData& gpu_scene;
     const RenderResult& result;
     double seconds_total = 0;
+    double seconds_to_render = 0;  // from the command's start to render(): load, BVH, upload
 };
 
 nlohmann::json render_stats_json(const RenderStatsInput& in);

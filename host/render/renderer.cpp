@@ -16,6 +16,14 @@
 
 namespace mcrt {
 
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
 uint32_t resolve_replicates(uint32_t requested, const RenderSettings& settings) {
     if (requested > 0) {
         if (MCRT_SAMPLES_PER_CHUNK % requested != 0 || settings.spp % requested != 0)
@@ -78,7 +86,7 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
     if (workers.empty()) throw RuntimeError("no device can render this scene: " + last_error);
 
     RenderResult result;
-    result.seconds_build = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.seconds_build = seconds_since(start);
     WorkQueue queue(pixels, settings.spp);
     Accumulator acc(pixels, settings.spp, settings.replicates);
     std::mutex acc_mutex;
@@ -103,6 +111,8 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
                 return;
             }
             std::lock_guard<std::mutex> lock(acc_mutex);
+            if (result.seconds_first_batch == 0)
+                result.seconds_first_batch = seconds_since(start);
             worker.commit_report();
             acc.submit(std::move(r));
             queue.done(*item);
@@ -130,7 +140,7 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
             if (progress) progress(acc.committed_spp(), settings.spp, device_reports());
             if (acc.committed_spp() >= settings.spp || all_retired()) break;
         }
-        double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        double elapsed = seconds_since(start);
         if (result.stopped_by.empty() && control.time_limit > 0 && elapsed >= control.time_limit) {
             result.stopped_by = "time limit";
             queue.stop();
@@ -146,6 +156,7 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
         std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     for (std::thread& t : threads) t.join();
+    result.seconds_render_wall = seconds_since(start) - result.seconds_build;
 
     if (acc.committed_spp() == 0 || (result.stopped_by.empty() && acc.committed_spp() < settings.spp))
         throw RuntimeError("every device failed; no image was completed");

@@ -66,6 +66,8 @@ struct RenderResult {
     uint64_t roulette_ends = 0;  // paths that Russian roulette ended
     double seconds_render = 0;   // kernel time summed over devices (profiling events)
     double seconds_build = 0;    // kernel compilation and scene upload
+    double seconds_render_wall = 0;  // wall clock from the first launch to the last result
+    double seconds_first_batch = 0;  // wall clock from render() to the first batch accumulated
     std::vector<DeviceReport> devices;
 };
 
