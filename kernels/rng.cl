@@ -83,6 +83,15 @@ inline float independent_1d(uint pixel, uint sample, uint dim, uint seed) {
     return uint_to_unit_float(pcg4d((uint4)(pixel, sample, dim, seed)).x);
 }
 
+/* Two independent uniform numbers for the pair (dim, dim + 1): the first two of the four words of
+ * one pcg4d(pixel, sample, dim, seed), whose outputs are independent of each other (Jarzynski &
+ * Olano 2020 test all four): one hash for a 2D sample instead of two (issue 16). The first is
+ * independent_1d of dim; the second is not that of dim + 1, and nothing reads both. */
+inline float2 independent_2d(uint pixel, uint sample, uint dim, uint seed) {
+    uint4 h = pcg4d((uint4)(pixel, sample, dim, seed));
+    return (float2)(uint_to_unit_float(h.x), uint_to_unit_float(h.y));
+}
+
 /* A hash key for one (pixel, dimension), the same for all samples of the pixel. */
 inline uint pixel_dimension_key(const SampleStream* s, uint dim) {
     return pcg4d((uint4)(s->pixel, 0xffffffffu, dim, replicate_seed(s))).y;
@@ -142,8 +151,7 @@ inline float2 sampler_2d(const SampleStream* s, uint dim) {
     while (nx * nx < s->sample_count) ++nx; /* float sqrt may round down */
     uint ny = (s->sample_count + nx - 1u) / nx;
     uint stratum = kensler_permute(s->sample, nx * ny, pixel_dimension_key(s, dim));
-    float2 jitter = (float2)(independent_1d(s->pixel, s->index, dim, s->seed),
-                             independent_1d(s->pixel, s->index, dim + 1u, s->seed));
+    float2 jitter = independent_2d(s->pixel, s->index, dim, s->seed);
     float2 v = (float2)(((float)(stratum % nx) + jitter.x) / (float)nx,
                         ((float)(stratum / nx) + jitter.y) / (float)ny);
     return min(v, (float2)(0x1.fffffep-1f));
@@ -182,21 +190,27 @@ inline uint sobol_dimension_1(uint index) {
     return x;
 }
 
+/* The three seeds of a pair's scrambles, per (pixel, dimension, replicate): y shuffles the sample
+ * index (as pixel_dimension_key), z and w scramble the two coordinates; three words of one hash,
+ * not three hashes (issue 16). */
+inline uint4 sobol_keys(const SampleStream* s, uint dim) {
+    return pcg4d((uint4)(s->pixel, 0xffffffffu, dim, replicate_seed(s)));
+}
+
 /* Owen-scrambled Sobol' (0,2)-sequence per dimension pair, padded by shuffling the sample index
  * with an independent scramble for each pair (Burley 2020, sec. 4). */
 inline float2 sampler_2d(const SampleStream* s, uint dim) {
-    uint key = pixel_dimension_key(s, dim);
-    uint index = nested_uniform_scramble(s->sample, key);
-    uint x = nested_uniform_scramble(reverse_bits(index), pcg4d((uint4)(key, 1u, 0u, 0u)).x);
-    uint y = nested_uniform_scramble(sobol_dimension_1(index), pcg4d((uint4)(key, 2u, 0u, 0u)).x);
+    uint4 key = sobol_keys(s, dim);
+    uint index = nested_uniform_scramble(s->sample, key.y);
+    uint x = nested_uniform_scramble(reverse_bits(index), key.z);
+    uint y = nested_uniform_scramble(sobol_dimension_1(index), key.w);
     return (float2)(uint_to_unit_float(x), uint_to_unit_float(y));
 }
 
 inline float sampler_1d(const SampleStream* s, uint dim) {
-    uint key = pixel_dimension_key(s, dim);
-    uint index = nested_uniform_scramble(s->sample, key);
-    return uint_to_unit_float(
-        nested_uniform_scramble(reverse_bits(index), pcg4d((uint4)(key, 1u, 0u, 0u)).x));
+    uint4 key = sobol_keys(s, dim);
+    uint index = nested_uniform_scramble(s->sample, key.y);
+    return uint_to_unit_float(nested_uniform_scramble(reverse_bits(index), key.z));
 }
 
 #else /* SAMPLER_INDEPENDENT */
@@ -204,9 +218,9 @@ inline float sampler_1d(const SampleStream* s, uint dim) {
     return independent_1d(s->pixel, s->index, dim, s->seed);
 }
 
-/* Dimensions dim and dim + 1. */
+/* Dimensions dim and dim + 1, from one hash. */
 inline float2 sampler_2d(const SampleStream* s, uint dim) {
-    return (float2)(sampler_1d(s, dim), sampler_1d(s, dim + 1u));
+    return independent_2d(s->pixel, s->index, dim, s->seed);
 }
 #endif
 
@@ -221,9 +235,7 @@ inline float sample_1d(const SampleStream* s, uint dim) {
 
 inline float2 sample_2d(const SampleStream* s, uint dim) {
     uint d = stream_dimension(s, dim);
-    if (past_qmc_vertices(s))
-        return (float2)(independent_1d(s->pixel, s->index, d, s->seed),
-                        independent_1d(s->pixel, s->index, d + 1u, s->seed));
+    if (past_qmc_vertices(s)) return independent_2d(s->pixel, s->index, d, s->seed);
     return sampler_2d(s, d);
 }
 

@@ -295,6 +295,12 @@ TEST_CASE("stress scenes: every example estimator file is finite and unbiased",
             for (const std::string& select : variant_names(kLightSelectVariants)) {
                 use_estimator_file(settings, file);
                 settings.light_select = select;
+                // A file that samples no light finds small or grazing lights by its directions
+                // alone, rarely: the built-in direction estimators' sample count (above).
+                // bsdf_directions.cl at 32 spp found grazing-light's light 0 to 5 times in
+                // 81920 samples, too few for its standard error to mean anything.
+                bool directions = settings.estimator_source.find("sample_light") == std::string::npos;
+                settings.spp = directions ? 256 : 32;
                 Renders r = independent_renders(device, data, settings, kRenders, kFirstSeed);
                 INFO(name << ": " << file << " / " << select << ": mean " << format(r.mean)
                           << ", exact " << format(exact) << ", standard error "
