@@ -239,9 +239,32 @@ std::string store_binary_cache_entry(const std::string& path, const BinaryCacheK
     }
 }
 
+// The misses of a key before this one, from its counter file, and the counter bumped; never
+// throws (an unreadable or unwritable counter counts as none: the binary is stored later).
+static int count_miss(const std::string& counter) {
+    int misses = 0;
+    {
+        std::ifstream in(counter);
+        if (!(in >> misses) || misses < 0) misses = 0;
+    }
+    try {
+        std::error_code ec;
+        fs::create_directories(fs::path(counter).parent_path(), ec);
+        write_atomically(counter, [&](const std::string& temporary) {
+            std::ofstream out(temporary, std::ios::trunc);
+            out << misses + 1 << "\n";
+            out.close();
+            if (!out) throw RuntimeError(temporary + ": cannot write");
+        });
+    } catch (const std::exception&) {
+    }
+    return misses;
+}
+
 cl::Program build_program_cached(const cl::Context& context, const cl::Device& device,
                                  const DeviceInfo& info, const std::string& source,
-                                 const std::string& options, BuildReport* report) {
+                                 const std::string& options, BuildReport* report,
+                                 int store_after_misses) {
     const auto t0 = std::chrono::steady_clock::now();
     BuildReport local;
     BuildReport& r = report ? *report : local;
@@ -268,9 +291,20 @@ cl::Program build_program_cached(const cl::Context& context, const cl::Device& d
         }
     }
 
-    // Miss or rejected entry: build from source (a failing build throws) and store the binary.
+    // Miss or rejected entry: build from source (a failing build throws) and store the binary,
+    // or count the miss while fewer than store_after_misses - 1 came before.
     cl::Program program = build_program(context, device, source, options);
+    const std::string counter = (fs::path(directory) / (key.hex() + ".misses")).string();
+    if (store_after_misses > 1 && count_miss(counter) + 1 < store_after_misses) {
+        r.store_deferred = true;
+        r.seconds = seconds_since(t0);
+        return program;
+    }
     r.store_error = store_binary_cache_entry(r.path, key, program_binary(program, device));
+    if (store_after_misses > 1 && r.store_error.empty()) {
+        std::error_code ignored;
+        fs::remove(counter, ignored);
+    }
     r.seconds = seconds_since(t0);
     return program;
 }

@@ -61,13 +61,19 @@ struct BuildReport {
     std::string path;         // the entry's file; empty when the cache is disabled
     std::string rejected;     // why an existing entry was not used (corrupt, driver refused)
     std::string store_error;  // why the entry could not be written; empty when written or hit
+    bool store_deferred = false;  // a miss counted, not stored (store_after_misses)
 };
 
 // The program of `source` built with `options` for `device` (a device of `context`): from the
 // cached binary when there is a valid one, else built from source (build_program: a failing
-// build throws RuntimeError with the build log) and its binary stored for the next start.
+// build throws RuntimeError with the build log) and its binary stored for the next start: at
+// once when store_after_misses is 1, else only at the store_after_misses-th miss of the key
+// (counted in <key>.misses beside the entry). For a driver whose own cache makes a rebuild
+// cheap and asking for the binary dear (PoCL: about 1 s of code generation per variant), a
+// variant built once or twice never pays for a binary that would not be read.
 cl::Program build_program_cached(const cl::Context& context, const cl::Device& device,
                                  const DeviceInfo& info, const std::string& source,
-                                 const std::string& options, BuildReport* report = nullptr);
+                                 const std::string& options, BuildReport* report = nullptr,
+                                 int store_after_misses = 1);
 
 }  // namespace mcrt

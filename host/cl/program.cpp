@@ -13,6 +13,9 @@
 
 namespace mcrt {
 
+// On a driver that caches kernels itself (PoCL), the binary is stored at this miss of a variant.
+constexpr int kDriverCachesStoreAfterMisses = 3;
+
 const std::map<std::string, std::string>& embedded_kernel_files();  // generated at build time
 
 static std::string read_kernel_file(const std::string& name) {
@@ -102,13 +105,20 @@ cl::Program cached_program(const DeviceContext& device, const std::string& file,
     std::lock_guard<std::mutex> lock(mutex);
     auto it = programs.find(key);
     if (it != programs.end()) return it->second;
-    // Across processes, the on-disk binary cache skips compilation. On PoCL too, although PoCL
-    // caches compiled kernels itself: its cache hit still preprocesses and hashes the source
-    // (0.05-0.09 s of a 0.15 s start), a binary hit does not (start to first sample 0.13 ->
-    // 0.06-0.07 s, docs/BENCHMARKS.md, issue 16). A miss costs PoCL a code generation for the
-    // binary (about 1 s per variant, once).
+    // Across processes, the on-disk binary cache skips compilation on drivers without their own.
+    // PoCL caches compiled kernels itself (unless POCL_KERNEL_CACHE=0), but its hit still
+    // preprocesses and hashes the source: 0.05-0.09 s, where a binary hit takes 0.015-0.025 s
+    // (start to first sample 0.13 -> 0.06-0.08 s on the Cornell box, docs/BENCHMARKS.md, issue
+    // 16). Asking PoCL for the binary costs a code generation (about 1 s per variant), so there
+    // the binary is stored at a variant's third build only: one built once or twice (most of a
+    // test suite's) never pays for it.
+    const char* pocl_cache = std::getenv("POCL_KERNEL_CACHE");
+    bool driver_caches = device.info.platform_name.find("Portable Computing Language") !=
+                             std::string::npos &&
+                         !(pocl_cache && std::string(pocl_cache) == "0");
     cl::Program program = build_program_cached(device.context, device.info.device, device.info,
-                                               source, options);
+                                               source, options, nullptr,
+                                               driver_caches ? kDriverCachesStoreAfterMisses : 1);
     programs.emplace(key, program);
     return program;
 }
