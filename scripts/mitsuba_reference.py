@@ -257,16 +257,21 @@ def mitsuba_bsdf(material, albedo, materials):
         % (material.get("name", "material"), metallic))
 
 
-def integrator(max_depth, rr_depth):
-    """Mitsuba's integrator for mcrt's --max-depth (reflections): `direct` at 1, else `path`."""
+def integrator(max_depth, rr_depth, emitter_samples=1, bsdf_samples=1):
+    """Mitsuba's integrator for mcrt's --max-depth (reflections): `direct` at 1 (emitter_samples
+    light and bsdf_samples BSDF samples per pixel sample; 1 and 0 is light sampling alone), else
+    `path`."""
     if max_depth <= 1:
-        return {"type": "direct", "hide_emitters": False}
+        return {"type": "direct", "hide_emitters": False, "emitter_samples": emitter_samples,
+                "bsdf_samples": bsdf_samples}
     return {"type": "path", "max_depth": max_depth + 1, "rr_depth": rr_depth,
             "hide_emitters": False}
 
 
 def mitsuba_scene(mi, gltf, width, height, spp, scratch, max_depth=1, rr_depth=5, sky=None,
-                  materials="lambert"):
+                  materials="lambert", integrator_desc=None):
+    """(scene dict, emitter count) of a glTF; PLY meshes are written to `scratch`. The
+    integrator is integrator_desc when given, else integrator(max_depth, rr_depth)."""
     triangles = gltf.triangles()
     if not triangles:
         raise ValueError("the scene has no triangles")
@@ -276,7 +281,7 @@ def mitsuba_scene(mi, gltf, width, height, spp, scratch, max_depth=1, rr_depth=5
     eye, forward, up, yfov = gltf.camera((lo, hi))
     scene = {
         "type": "scene",
-        "integrator": integrator(max_depth, rr_depth),
+        "integrator": integrator_desc or integrator(max_depth, rr_depth),
         "sensor": {
             "type": "perspective", "fov_axis": "y", "fov": math.degrees(yfov),
             "near_clip": 1e-4 * diag, "far_clip": 1e3 * diag,
@@ -313,22 +318,36 @@ def mitsuba_scene(mi, gltf, width, height, spp, scratch, max_depth=1, rr_depth=5
     return scene, emitters
 
 
-def render(args):
+def import_mitsuba(variant):
+    """The mitsuba module with `variant` set."""
     # Dr.Jit's LLVM backend needs LLVM 19 (DESIGN.md "Dependencies"): Debian's libllvm19.
-    if args.variant.startswith("llvm") and Path(DEBIAN_LLVM19).exists():
+    if variant.startswith("llvm") and Path(DEBIAN_LLVM19).exists():
         os.environ.setdefault("DRJIT_LIBLLVM_PATH", DEBIAN_LLVM19)
     import mitsuba as mi
-    mi.set_variant(args.variant)
-    gltf = Gltf(args.scene)
-    passes = max(1, min(args.passes, args.spp))
-    spp_pass = args.spp // passes
+    mi.set_variant(variant)
+    return mi
+
+
+def load_scene(mi, path, width, height, spp, max_depth=1, rr_depth=5, sky=None,
+               materials="lambert", integrator_desc=None):
+    """(loaded Mitsuba scene, emitter count, seconds of mi.load_dict) of the glTF at `path`
+    (mitsuba_scene's arguments)."""
+    gltf = Gltf(path)
     with tempfile.TemporaryDirectory(prefix="mcrt-mitsuba-") as scratch:
-        desc, emitters = mitsuba_scene(mi, gltf, args.width, args.height, spp_pass, scratch,
-                                       args.max_depth, args.rr_depth, args.sky,
-                                       args.materials)
+        desc, emitters = mitsuba_scene(mi, gltf, width, height, spp, scratch, max_depth,
+                                       rr_depth, sky, materials, integrator_desc)
         start = time.monotonic()
         scene = mi.load_dict(desc)
-        seconds_load = time.monotonic() - start
+        return scene, emitters, time.monotonic() - start
+
+
+def render(args):
+    mi = import_mitsuba(args.variant)
+    passes = max(1, min(args.passes, args.spp))
+    spp_pass = args.spp // passes
+    scene, emitters, seconds_load = load_scene(mi, args.scene, args.width, args.height, spp_pass,
+                                               args.max_depth, args.rr_depth, args.sky,
+                                               args.materials)
     sum1 = np.zeros((args.height, args.width, 3))
     sum2 = np.zeros_like(sum1)
     seconds = []
@@ -458,15 +477,16 @@ def equal_time(args, mitsuba_rgb):
     return result
 
 
-def use_mitsuba_venv():
-    """Re-executes this script with a repository venv's Python when mitsuba is not importable."""
+def use_mitsuba_venv(script=__file__):
+    """Re-executes `script` (this one by default) with a repository venv's Python, with the
+    same arguments, when mitsuba is not importable."""
     if importlib.util.find_spec("mitsuba") is not None:
         return
     root = Path(__file__).resolve().parent.parent
     for venv in (".venv-mitsuba", ".venv"):
         python = root / venv / "bin" / "python"
         if python.exists() and Path(sys.prefix).resolve() != (root / venv).resolve():
-            os.execv(str(python), [str(python), str(Path(__file__).resolve())] + sys.argv[1:])
+            os.execv(str(python), [str(python), str(Path(script).resolve())] + sys.argv[1:])
     raise mcrt_run.ScriptError("Mitsuba 3 is not installed (see --help)")
 
 
