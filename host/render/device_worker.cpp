@@ -100,6 +100,10 @@ DeviceWorker::DeviceWorker(const DeviceContext& device, const GpuSceneData& scen
     CL_CHECK(reduce_.setArg(3, cl_uint(settings.replicates)));
 }
 
+DeviceWorker::~DeviceWorker() {
+    if (!launches_in_flight_.empty()) device_.queue.finish();  // a failure: nothing to report
+}
+
 void DeviceWorker::reserve_sums(uint64_t runs) {
     if (runs <= sums_capacity_) return;
     sums_capacity_ = std::max<uint64_t>(runs, max_samples_ / MCRT_SAMPLES_PER_CHUNK);
@@ -116,6 +120,11 @@ uint64_t DeviceWorker::target_samples() const {
 }
 
 BatchResult DeviceWorker::run(const WorkItem& item) {
+    start(item);
+    return finish();
+}
+
+void DeviceWorker::start(const WorkItem& item) {
     const uint32_t sample_begin = item.chunk_begin * MCRT_SAMPLES_PER_CHUNK;
     const uint32_t sample_end =
         std::min<uint32_t>(item.chunk_end * MCRT_SAMPLES_PER_CHUNK, settings_.spp);
@@ -145,35 +154,52 @@ BatchResult DeviceWorker::run(const WorkItem& item) {
     params.replicates = settings_.replicates;
     params.max_depth = settings_.max_depth;
     params.rr_depth = settings_.rr_depth;
+    // Arguments are captured at each enqueue: changing them for the next item is safe while
+    // this one is in flight.
     CL_CHECK(render_.setArg(gpu::RENDER_ARG_PARAMS, sizeof params, &params));
     const cl_uint chunks = item.chunk_count();
     const uint64_t runs = uint64_t(item.pixel_count()) * chunks * settings_.replicates;
-    reserve_sums(runs);
+    reserve_sums(runs);  // a replaced buffer lives on until the commands using it are done
     CL_CHECK(reduce_.setArg(1, n));
     CL_CHECK(reduce_.setArg(2, cl_uint(item.pixel_count())));
 
-    cl::Event render_done, reduce_done;
-    // A fixed work-group size: PoCL specialises a kernel per local size, and a NULL local size
-    // lets it pick a new one for each global size (a compile per launch).
-    CL_CHECK(device_.queue.enqueueNDRangeKernel(render_, cl::NullRange,
-                                                cl::NDRange(round_up(samples, kGroupSize)),
-                                                cl::NDRange(kGroupSize), nullptr, &render_done));
-    CL_CHECK(device_.queue.enqueueNDRangeKernel(
-        reduce_, cl::NullRange,
-        cl::NDRange(round_up(uint64_t(item.pixel_count()) * chunks, kGroupSize)),
-        cl::NDRange(kGroupSize), nullptr, &reduce_done));
-    BatchResult result;
-    result.item = item;
-    result.sums.resize(runs);
-    CL_CHECK(device_.queue.enqueueReadBuffer(sums_, CL_TRUE, 0, runs * sizeof(gpu::ChunkSums),
-                                             result.sums.data()));
-    double busy = event_seconds(render_done) + event_seconds(reduce_done);
+    launches_in_flight_.emplace_back();
+    Launch& launch = launches_in_flight_.back();
+    launch.result.item = item;
+    launch.result.sums.resize(runs);
+    launch.samples = samples;
+    try {
+        // A fixed work-group size: PoCL specialises a kernel per local size, and a NULL local
+        // size lets it pick a new one for each global size (a compile per launch).
+        CL_CHECK(device_.queue.enqueueNDRangeKernel(
+            render_, cl::NullRange, cl::NDRange(round_up(samples, kGroupSize)),
+            cl::NDRange(kGroupSize), nullptr, &launch.render_done));
+        CL_CHECK(device_.queue.enqueueNDRangeKernel(
+            reduce_, cl::NullRange,
+            cl::NDRange(round_up(uint64_t(item.pixel_count()) * chunks, kGroupSize)),
+            cl::NDRange(kGroupSize), nullptr, &launch.reduce_done));
+        CL_CHECK(device_.queue.enqueueReadBuffer(sums_, CL_FALSE, 0,
+                                                 runs * sizeof(gpu::ChunkSums),
+                                                 launch.result.sums.data(), nullptr,
+                                                 &launch.read_done));
+        CL_CHECK(device_.queue.flush());  // start now, not at the next blocking call
+    } catch (...) {
+        launches_in_flight_.pop_back();
+        throw;
+    }
+}
+
+BatchResult DeviceWorker::finish() {
+    Launch launch = std::move(launches_in_flight_.front());
+    launches_in_flight_.pop_front();
+    CL_CHECK(launch.read_done.wait());
+    double busy = event_seconds(launch.render_done) + event_seconds(launch.reduce_done);
     if (slow_factor_ > 1.0)  // simulate a slower device (MCRT_SLOW_DEVICE)
         std::this_thread::sleep_for(std::chrono::duration<double>(busy * (slow_factor_ - 1.0)));
     // Counted into the report by commit_report(), under the lock the progress reads it with.
     pending_busy_ = busy;
-    pending_samples_ = samples;
-    return result;
+    pending_samples_ = launch.samples;
+    return std::move(launch.result);
 }
 
 void DeviceWorker::commit_report() {

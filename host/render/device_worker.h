@@ -4,6 +4,7 @@
 
 #include <CL/opencl.hpp>
 #include <cstdint>
+#include <deque>
 #include <memory>
 
 #include "cl/device.h"
@@ -27,6 +28,8 @@ class DeviceWorker : public RenderWorker {
     // `fixed_batch_samples` > 0 makes every launch that many samples (--batch).
     DeviceWorker(const DeviceContext& device, const GpuSceneData& scene,
                  const RenderSettings& settings, uint64_t fixed_batch_samples);
+    // Waits for the commands still in flight: they write into this worker's host memory.
+    ~DeviceWorker() override;
 
     // Samples the next launch should hold: a fixed --batch, else a probe, then what the
     // measured speed does in about 150 ms.
@@ -34,6 +37,13 @@ class DeviceWorker : public RenderWorker {
 
     // Renders and reduces one work item; throws RuntimeError when the device fails.
     BatchResult run(const WorkItem& item) override;
+
+    // Two items in flight: the in-order queue runs the second's kernels while the host takes the
+    // first's sums (the samples buffer is shared: the queue's order keeps the second render
+    // after the first reduction, and each item reads into its own host memory).
+    size_t pipeline_depth() const override { return 2; }
+    void start(const WorkItem& item) override;
+    BatchResult finish() override;
 
     // Adds the last successful launch to the report; the caller holds the render's lock.
     void commit_report() override;
@@ -56,6 +66,12 @@ private:
     std::unique_ptr<GpuSceneBuffers> buffers_;
     cl::Buffer samples_, sums_;
     uint64_t sums_capacity_ = 0;  // ChunkSums the sums_ buffer holds
+    struct Launch {  // a started item: its result (sums read into it) and its commands' events
+        BatchResult result;
+        uint64_t samples = 0;
+        cl::Event render_done, reduce_done, read_done;
+    };
+    std::deque<Launch> launches_in_flight_;
 };
 
 }  // namespace mcrt

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 
 #include "render/accumulator.h"
 #include "render/renderer.h"
@@ -24,7 +25,23 @@ class RenderWorker {
     // Adds the last successful run to `report`; the caller holds the render's lock.
     virtual void commit_report() = 0;
 
+    // Pipelining: start() begins an item without waiting for it, finish() waits for the oldest
+    // started one and returns its sums (both throw as run does). The scheduler keeps up to
+    // pipeline_depth() items started, so that a device renders the next item while the host
+    // reads and adds the last. By default one at a time: start() keeps the item, finish() runs
+    // it.
+    virtual size_t pipeline_depth() const { return 1; }
+    virtual void start(const WorkItem& item) { started_.push_back(item); }
+    virtual BatchResult finish() {
+        WorkItem item = started_.front();
+        started_.pop_front();
+        return run(item);
+    }
+
     DeviceReport report;
+
+  private:
+    std::deque<WorkItem> started_;
 };
 
 }  // namespace mcrt

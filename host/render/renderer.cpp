@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
+#include <deque>
 #include <cstdlib>
 #include <mutex>
 #include <thread>
@@ -101,18 +102,34 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
         for (const auto& w : workers) r.push_back(w->report);
         return r;
     };
+    // Each device keeps up to pipeline_depth() items started (one until its first result has
+    // measured its speed, so that the second is sized by it), and commits them in order.
     auto device_loop = [&](RenderWorker& worker, std::optional<WorkItem> item) {
-        for (; item; item = queue.take(worker.target_samples())) {
+        std::deque<WorkItem> started;
+        for (;;) {
             BatchResult r;
             try {
-                r = worker.run(*item);
+                for (;;) {  // top up the pipeline
+                    if (!item) {
+                        size_t depth = worker.report.batches == 0 ? 1 : worker.pipeline_depth();
+                        if (started.size() >= depth) break;
+                        item = queue.take(worker.target_samples(), started.empty());
+                        if (!item) break;
+                    }
+                    worker.start(*item);
+                    started.push_back(*item);
+                    item.reset();
+                }
+                if (started.empty()) return;
+                r = worker.finish();
             } catch (const RuntimeError& e) {
                 std::lock_guard<std::mutex> lock(acc_mutex);
                 worker.report.retired = true;
                 const std::string rank =
                     worker.report.rank > 0 ? "rank " + std::to_string(worker.report.rank) + " " : "";
                 if (warn) warn(rank + "device " + std::to_string(worker.report.index) + " ('" + worker.report.name + "') failed and is retired; its work is redone on the other devices: " + e.what());
-                queue.give_back(*item);
+                if (item) queue.give_back(*item);
+                for (const WorkItem& w : started) queue.give_back(w);
                 progress_made.notify_all();
                 return;
             }
@@ -121,7 +138,8 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
                 result.seconds_first_batch = seconds_since(start);
             worker.commit_report();
             acc.submit(std::move(r));
-            queue.done(*item);
+            queue.done(started.front());
+            started.pop_front();
             progress_made.notify_all();
         }
     };

@@ -14,7 +14,7 @@ uint32_t WorkQueue::samples_in_chunk(uint32_t chunk) const {
     return std::min<uint32_t>(MCRT_SAMPLES_PER_CHUNK, spp_ - chunk * MCRT_SAMPLES_PER_CHUNK);
 }
 
-std::optional<WorkItem> WorkQueue::take(uint64_t target_samples) {
+std::optional<WorkItem> WorkQueue::take(uint64_t target_samples, bool wait) {
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
         if (!redo_.empty()) {
@@ -26,7 +26,7 @@ std::optional<WorkItem> WorkQueue::take(uint64_t target_samples) {
         bool first_row_out = next_chunk_ > 0;
         bool all_out = next_chunk_ >= chunks_;
         if (!all_out && !(stopped_ && first_row_out)) break;
-        if (in_flight_ == 0) return std::nullopt;
+        if (in_flight_ == 0 || !wait) return std::nullopt;
         changed_.wait(lock);
     }
 

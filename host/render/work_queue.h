@@ -27,8 +27,10 @@ public:
 
     // The next item of about target_samples samples (never fewer than one chunk of 64 pixels),
     // or nothing when the render is complete or stopped. Blocks while nothing is left to hand
-    // out but items are still in flight, since a failing device may give one back.
-    std::optional<WorkItem> take(uint64_t target_samples);
+    // out but items are still in flight, since a failing device may give one back; with
+    // `wait` false returns nothing instead (a device topping up its pipeline must not wait for
+    // the items it holds itself).
+    std::optional<WorkItem> take(uint64_t target_samples, bool wait = true);
     void done(const WorkItem& item);       // the item's result has been delivered
     void give_back(const WorkItem& item);  // its device failed: another device redoes it
     // Stops handing out new items once the first chunk row is handed out, so a stopped render
