@@ -182,10 +182,11 @@ inline uint nested_uniform_scramble(uint x, uint seed) {
 }
 
 /* The first two Sobol' dimensions: van der Corput, and the one with direction numbers
- * v_1 = 2^31, v_k = v_{k-1} ^ (v_{k-1} >> 1) (primitive polynomial x + 1). */
-inline uint sobol_dimension_1(uint index) {
-    uint x = 0u, v = 0x80000000u;
-    for (; index != 0u; index >>= 1, v ^= v >> 1)
+ * v_1 = 2^31, v_k = v_{k-1} ^ (v_{k-1} >> 1) (primitive polynomial x + 1), here bit-reversed
+ * (v_1 = 1, v_k = v_{k-1} ^ (v_{k-1} << 1)): what the scramble below reverses first. */
+inline uint sobol_dimension_1_reversed(uint index) {
+    uint x = 0u, v = 1u;
+    for (; index != 0u; index >>= 1, v ^= v << 1)
         if (index & 1u) x ^= v;
     return x;
 }
@@ -198,19 +199,22 @@ inline uint4 sobol_keys(const SampleStream* s, uint dim) {
 }
 
 /* Owen-scrambled Sobol' (0,2)-sequence per dimension pair, padded by shuffling the sample index
- * with an independent scramble for each pair (Burley 2020, sec. 4). */
+ * with an independent scramble for each pair (Burley 2020, sec. 4). The coordinates are
+ * nested_uniform_scramble(reverse_bits(index)) and nested_uniform_scramble(sobol_dimension_1(
+ * index)), written without the bit reversals that cancel (reverse_bits is an involution): 3
+ * reversals per pair instead of 6, the same bits (issue 16). */
 inline float2 sampler_2d(const SampleStream* s, uint dim) {
     uint4 key = sobol_keys(s, dim);
     uint index = nested_uniform_scramble(s->sample, key.y);
-    uint x = nested_uniform_scramble(reverse_bits(index), key.z);
-    uint y = nested_uniform_scramble(sobol_dimension_1(index), key.w);
+    uint x = reverse_bits(laine_karras_permutation(index, key.z));
+    uint y = reverse_bits(laine_karras_permutation(sobol_dimension_1_reversed(index), key.w));
     return (float2)(uint_to_unit_float(x), uint_to_unit_float(y));
 }
 
 inline float sampler_1d(const SampleStream* s, uint dim) {
     uint4 key = sobol_keys(s, dim);
     uint index = nested_uniform_scramble(s->sample, key.y);
-    return uint_to_unit_float(nested_uniform_scramble(reverse_bits(index), key.z));
+    return uint_to_unit_float(reverse_bits(laine_karras_permutation(index, key.z)));
 }
 
 #else /* SAMPLER_INDEPENDENT */
