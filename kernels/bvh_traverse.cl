@@ -79,8 +79,9 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePa
 
     BoxRay b = make_box_ray(r);
     PacketRay q = make_packet_ray(r);
-    uint stack_ref[BVH_STACK_SIZE], stack_count[BVH_STACK_SIZE];
-    float stack_t[BVH_STACK_SIZE];
+    /* One spare entry at the end takes the writes of children that are not pushed. */
+    uint stack_ref[BVH_STACK_SIZE + 1], stack_count[BVH_STACK_SIZE + 1];
+    float stack_t[BVH_STACK_SIZE + 1];
     int sp = 0;
     /* The current child: a Bvh4Node index when count is 0, else a leaf's first packet. */
     uint ref = 0u, count = 0u;
@@ -88,29 +89,35 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePa
         if (count == 0u) {
             global const Bvh4Node* node = nodes + ref;
             float4 t4 = bvh4_entry(node, &b, hit.t);
-            float t_in[4] = {t4.x, t4.y, t4.z, t4.w};
-            /* Insertion sort of the entered children, farthest first, nearest last. */
-            float ts[4];
-            uint slot[4];
-            int n = 0;
-            for (uint i = 0; i < 4u; ++i) {
-                if (t_in[i] == MAXFLOAT) continue;
-                int j = n++;
-                for (; j > 0 && ts[j - 1] < t_in[i]; --j) {
-                    ts[j] = ts[j - 1];
-                    slot[j] = slot[j - 1];
-                }
-                ts[j] = t_in[i];
-                slot[j] = i;
-            }
-            if (n > 0) {
-                for (int k = 0; k < n - 1 && sp < BVH_STACK_SIZE; ++k, ++sp) {
-                    stack_ref[sp] = node->child[slot[k]];
-                    stack_count[sp] = node->count[slot[k]];
-                    stack_t[sp] = ts[k];
-                }
-                ref = node->child[slot[n - 1]];
-                count = node->count[slot[n - 1]];
+            int4 entered = t4 != (float4)(MAXFLOAT);
+            if (any(entered)) {
+                /* Children are visited nearest first, a later slot first among equals. A child's
+                 * visit rank is the number of entered children before it in that order, found
+                 * by compares against the rotated distances (a sorting network without
+                 * branches or private arrays: the insertion sort it replaces mispredicted on
+                 * every node, docs/BENCHMARKS.md, issue 16). Non-entered children are at
+                 * MAXFLOAT, after every entered one. */
+                float4 r1 = t4.yzwx, r2 = t4.zwxy, r3 = t4.wxyz;
+                int4 before1 = (r1 < t4) | ((r1 == t4) & (int4)(-1, -1, -1, 0));
+                int4 before2 = (r2 < t4) | ((r2 == t4) & (int4)(-1, -1, 0, 0));
+                int4 before3 = (r3 < t4) | ((r3 == t4) & (int4)(-1, 0, 0, 0));
+                int4 rank = -(before1 + before2 + before3);
+                int n = -(entered.x + entered.y + entered.z + entered.w);
+                /* Rank 0 is visited next; rank k > 0 goes to stack entry sp + n - 1 - k, so
+                 * that the stack pops ranks 1, 2, ... in turn. Children that are not pushed
+                 * (not entered, rank 0, or beyond a full stack) write the spare entry. */
+                int4 pos = (int4)(sp + n - 1) - rank;
+                pos = select((int4)(BVH_STACK_SIZE), pos,
+                             entered & (rank > 0) & (pos < (int4)(BVH_STACK_SIZE)));
+                uint4 child = vload4(0, node->child), cnt = vload4(0, node->count);
+                stack_ref[pos.x] = child.x, stack_count[pos.x] = cnt.x, stack_t[pos.x] = t4.x;
+                stack_ref[pos.y] = child.y, stack_count[pos.y] = cnt.y, stack_t[pos.y] = t4.y;
+                stack_ref[pos.z] = child.z, stack_count[pos.z] = cnt.z, stack_t[pos.z] = t4.z;
+                stack_ref[pos.w] = child.w, stack_count[pos.w] = cnt.w, stack_t[pos.w] = t4.w;
+                sp = min(sp + n - 1, BVH_STACK_SIZE);
+                int4 first = entered & (rank == 0);
+                ref = first.x ? child.x : first.y ? child.y : first.z ? child.z : child.w;
+                count = first.x ? cnt.x : first.y ? cnt.y : first.z ? cnt.z : cnt.w;
                 continue;
             }
         } else {
