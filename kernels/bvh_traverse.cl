@@ -125,19 +125,24 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePa
              * leaf order, a later one only if strictly nearer, as one at a time would. */
             global const TrianglePacket* pk = packets + ref;
             for (uint k = 0; k < count; k += MCRT_PACKET_WIDTH, ++pk) {
-                float4 t4, b1, b2;
+                float4 t4 = (float4)(0.0f), b1 = (float4)(0.0f), b2 = (float4)(0.0f);
                 int4 lanes = intersect_packet(&q, pk, hit.t, &t4, &b1, &b2);
-                if (!any(lanes)) continue;
                 /* The nearest hit lane, the first of equals (leaf order, as one triangle at a time
-                 * would take them), by compares instead of a loop over private arrays. */
+                 * would take them), by compares instead of a loop over private arrays; taken by
+                 * selects, not a branch on whether any lane hit (which mispredicted). A lane hits
+                 * only nearer than hit.t, so m < hit.t exactly when one does. */
                 float4 tm = select((float4)(MAXFLOAT), t4, lanes);
                 float2 m2 = min(tm.xy, tm.zw);
                 float m = min(m2.x, m2.y);
                 int i = tm.x == m ? 0 : tm.y == m ? 1 : tm.z == m ? 2 : 3;
-                hit.t = m;
-                hit.b1 = i == 0 ? b1.x : i == 1 ? b1.y : i == 2 ? b1.z : b1.w;
-                hit.b2 = i == 0 ? b2.x : i == 1 ? b2.y : i == 2 ? b2.z : b2.w;
-                hit.lane = MCRT_PACKET_WIDTH * (ref + k / MCRT_PACKET_WIDTH) + (uint)i;
+                bool nearer = m < hit.t;
+                float hb1 = i == 0 ? b1.x : i == 1 ? b1.y : i == 2 ? b1.z : b1.w;
+                float hb2 = i == 0 ? b2.x : i == 1 ? b2.y : i == 2 ? b2.z : b2.w;
+                uint lane = MCRT_PACKET_WIDTH * (ref + k / MCRT_PACKET_WIDTH) + (uint)i;
+                hit.t = nearer ? m : hit.t;
+                hit.b1 = nearer ? hb1 : hit.b1;
+                hit.b2 = nearer ? hb2 : hit.b2;
+                hit.lane = nearer ? lane : hit.lane;
             }
         }
         /* Pop, skipping children entered beyond the closest hit found since they were pushed. */
