@@ -9,7 +9,9 @@ renders once to warm its kernel cache, then --rounds rounds render every variant
 second are those of the stats (kernel time from OpenCL profiling events) and, beside them, per
 second of the process's CPU time (set-up included: a few per cent at the default size, but far
 less disturbed by other jobs on a shared machine); the table gives the median and range of each
-variant and its median ratio to the first, and says whether its image is
+variant, its ratio of medians to the first and the median of its per-round ratios to the first
+(each round's render against the first variant's of the same round, a second apart: the machine's
+speed drifts by tens of per cent over minutes), and says whether its image is
 bitwise that of the first variant (the pixels' float bits, not the file: the file's attributes
 hold times).
 
@@ -100,19 +102,25 @@ def main():
                              "cpu_msamples_per_second": [x / 1e6 for x in cpu_rates[label]],
                              "cpu_ratio": statistics.median(cpu_rates[label]) /
                              statistics.median(cpu_rates[base]),
+                             # Each round's ratio to the baseline rendered just before it: the
+                             # machine's speed drifts by tens of per cent over minutes, less
+                             # between two renders a second apart.
+                             "paired_ratios": [x / b for x, b in zip(rates[label], rates[base])],
                              "bitwise_same": same_bits(images[label], images[base])})
                 print("bench_ab: %s" % json.dumps(rows[-1]), file=sys.stderr)
     print("options: %s; %d rounds, alternating" % (" ".join(str(o) for o in options), args.rounds))
     print()
-    print("| scene | variant | Msamples/s median (range) | ratio to %s | samples per CPU µs "
-          "median (range) | ratio | image bitwise %s's |" % (args.variant[0][0], args.variant[0][0]))
-    print("|---|---|---|---|---|---|---|")
+    print("| scene | variant | Msamples/s median (range) | ratio to %s | paired ratio median "
+          "(range) | samples per CPU µs median (range) | ratio | image bitwise %s's |"
+          % (args.variant[0][0], args.variant[0][0]))
+    print("|---|---|---|---|---|---|---|---|")
     for row in rows:
-        x, c = row["msamples_per_second"], row["cpu_msamples_per_second"]
-        print("| %s | %s | %.3f (%.3f–%.3f) | %.3f | %.3f (%.3f–%.3f) | %.3f | %s |" % (
-            row["scene"], row["variant"], row["median"], min(x), max(x), row["ratio"],
-            statistics.median(c), min(c), max(c), row["cpu_ratio"],
-            "yes" if row["bitwise_same"] else "**no**"))
+        x, c, q = row["msamples_per_second"], row["cpu_msamples_per_second"], row["paired_ratios"]
+        print("| %s | %s | %.3f (%.3f–%.3f) | %.3f | %.3f (%.3f–%.3f) | %.3f (%.3f–%.3f) | %.3f "
+              "| %s |" % (
+                  row["scene"], row["variant"], row["median"], min(x), max(x), row["ratio"],
+                  statistics.median(q), min(q), max(q), statistics.median(c), min(c), max(c),
+                  row["cpu_ratio"], "yes" if row["bitwise_same"] else "**no**"))
     if args.json:
         Path(args.json).write_text(json.dumps({"command": sys.argv, "rows": rows}, indent=1))
 
