@@ -14,6 +14,7 @@
 #include "independent_renders.h"
 #include "process_support.h"
 #include "render/variants.h"
+#include "scene/gltf_import.h"
 
 using namespace mcrt;
 using namespace mcrt::test;
@@ -62,23 +63,38 @@ TEST_CASE("examples/estimators/light_area.cl renders light-area's image bit for 
         }
 }
 
-TEST_CASE("examples/estimators/bsdf_directions.cl renders bsdf's image bit for bit on glossy and Lambertian surfaces",
+TEST_CASE("examples/estimators/bsdf_directions.cl renders bsdf's image bit for bit on glossy and Lambertian surfaces, and under the sky light",
           "[estimator-file][cli][materials]") {
     TempDir tmp("mcrt-estimator-file");
     const std::string example = std::string(MCRT_EXAMPLES) + "/estimators/bsdf_directions.cl";
     const std::string dielectric = std::string(MCRT_SCENES) + "/glossy/dielectric-plane.gltf";
-    for (const std::string& scene : {dielectric, kCornell})
-        for (const char* materials : {"gltf", "lambert"}) {
+    struct Case {
+        std::string scene;
+        const char* materials;
+        const char* sky;  // "0": no sky light
+    };
+    // The Cornell box's open front lets BSDF directions escape: with --sky they see the sky
+    // light, which the built-in counts and the file must too.
+    std::vector<Case> cases = {{dielectric, "gltf", "0"},
+                               {dielectric, "lambert", "0"},
+                               {kCornell, "gltf", "0"},
+                               {kCornell, "lambert", "0"},
+                               {kCornell, "lambert", "0.5"}};
+    for (const Case& c : cases) {
+        const std::string& scene = c.scene;
+        const char* materials = c.materials;
+        {
             std::vector<std::string> common = {scene, "--width", "32", "--height", "32", "--spp",
                                                "32", "--seed", "3", "--sampler", "sobol",
                                                "--materials", materials, "--quiet"};
+            if (std::string(c.sky) != "0") common.insert(common.end(), {"--sky", c.sky});
             std::vector<std::string> builtin = {"render", "--out", tmp / "builtin.exr",
                                                 "--estimator", "bsdf"};
             std::vector<std::string> file = {"render", "--out", tmp / "file.exr",
                                              "--estimator-file", example};
             builtin.insert(builtin.end(), common.begin(), common.end());
             file.insert(file.end(), common.begin(), common.end());
-            INFO(scene << " / " << materials);
+            INFO(scene << " / " << materials << " / sky " << c.sky);
             REQUIRE(run_mcrt(tmp, builtin).exit_code == 0);
             REQUIRE(run_mcrt(tmp, file).exit_code == 0);
             Image a = read_exr(tmp / "builtin.exr"), b = read_exr(tmp / "file.exr");
@@ -87,6 +103,7 @@ TEST_CASE("examples/estimators/bsdf_directions.cl renders bsdf's image bit for b
             CHECK(sum > 0);
             CHECK(same_bits(a.rgb, b.rgb));
         }
+    }
 }
 
 TEST_CASE("an estimator file is called at every vertex of a path: light-area's image bit for bit",
@@ -163,6 +180,45 @@ TEST_CASE("estimator files that cannot be used are refused with exit 2", "[estim
     CHECK(empty.exit_code == 2);
     CHECK(empty.err.find("defines no function float3 estimate") != std::string::npos);
     CHECK_FALSE(std::filesystem::exists(tmp / "x.exr"));
+}
+
+TEST_CASE("every example estimator counts the sky light: under --sky its mean is light-area's",
+          "[estimator-file][estimators][sky]") {
+    // The Cornell box's open front lets the sky light in: a file that ignored it (as
+    // light_contribution.cl and bsdf_directions.cl once did) would miss by far more than its
+    // error bar, which the second check makes sure of.
+    DeviceContext device = first_device();
+    Scene scene = load_gltf(kCornell, nullptr);
+    RenderSettings settings;
+    settings.width = 16;
+    settings.height = 16;
+    settings.spp = 64;
+    settings.sky = glm::vec3(0.5f);
+    settings.sky_light = true;
+    GpuSceneData data = gpu_scene_for(scene, scene.cameras.front(), settings);
+    RenderSettings builtin = settings;
+    builtin.estimator = "light-area";
+    Renders with_sky = independent_renders(device, data, builtin, 10, 500);
+    builtin.sky_light = false;
+    Renders without = independent_renders(device, data, builtin, 10, 500);
+    for (const std::string& file : example_estimator_files()) {
+        RenderSettings s = settings;
+        use_estimator_file(s, file);
+        // Files that sample no light find the small ceiling light by their directions alone.
+        if (s.estimator_source.find("sample_light") == std::string::npos) s.spp = 256;
+        Renders r = independent_renders(device, data, s, 10, 700);
+        INFO(file << ": mean (" << r.mean.x << ", " << r.mean.y << ", " << r.mean.z
+                  << "), light-area's (" << with_sky.mean.x << ", " << with_sky.mean.y << ", "
+                  << with_sky.mean.z << "), without the sky (" << without.mean.x << ", "
+                  << without.mean.y << ", " << without.mean.z << ")");
+        CHECK(r.nan_samples == 0);
+        CHECK(r.non_finite_pixels == 0);
+        for (int c = 0; c < 3; ++c) {
+            double se = std::hypot(r.standard_error[c], with_sky.standard_error[c]);
+            CHECK(std::abs(r.mean[c] - with_sky.mean[c]) <= 4.5 * se);
+            CHECK(with_sky.mean[c] - without.mean[c] > 10.0 * se);  // the check has power
+        }
+    }
 }
 
 TEST_CASE("every example estimator is unbiased on a polygon light over a plane",

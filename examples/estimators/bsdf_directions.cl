@@ -6,7 +6,8 @@
  *     mcrt render scenes/cornell/CornellBox-Original.gltf --out a.exr \
  *         --estimator-file examples/estimators/bsdf_directions.cl
  *
- * Estimate: f(wo, wi) · Le(hit, −wi) · cosθ / pdf_w(wi) (GI Compendium eq. 35). */
+ * Estimate: f(wo, wi) · Le(hit, −wi) · cosθ / pdf_w(wi) (GI Compendium eq. 35), Le the sky
+ * light's where wi leaves the scene under --sky. */
 
 float3 estimate(const SceneView* scene, const SurfacePoint* sp, const SampleStream* stream,
                 uint* rays) {
@@ -14,6 +15,8 @@ float3 estimate(const SceneView* scene, const SurfacePoint* sp, const SampleStre
     if (!(bs.pdf_w > 0.0f) || bs.cos_theta <= 0.0f) return (float3)(0.0f);
 
     SurfacePoint seen;
-    if (!trace_from(scene, sp, bs.wi, rays, &seen)) return (float3)(0.0f); /* left the scene */
-    return bs.f * emitted_radiance(&seen) * (bs.cos_theta / bs.pdf_w);
+    /* A direction that leaves the scene sees the sky light (black without --sky). */
+    float3 Le = trace_from(scene, sp, bs.wi, rays, &seen) ? emitted_radiance(&seen)
+                                                          : environment_radiance(scene);
+    return bs.f * Le * (bs.cos_theta / bs.pdf_w);
 }

@@ -17,7 +17,8 @@
  * of tens to hundreds of lights — a light tree does it in O(log lights)); pmf = w_i / Σw; the
  * point is uniform on the light, as in light-area, from the same 2D sample: its x, remapped
  * within the chosen light's share of [0, 1), and its y. The random numbers are light-area's
- * (DIM_LIGHT): the two compare on common random numbers. */
+ * (DIM_LIGHT): the two compare on common random numbers. Under --sky the sky light is chosen
+ * first with light-area's probability, from the lower part of the same x. */
 
 #define CONTRIBUTION_COSINE_FLOOR 0.05f
 
@@ -44,6 +45,22 @@ inline float light_importance(const SurfacePoint* sp, const Light* light) {
 
 float3 estimate(const SceneView* scene, const SurfacePoint* sp, const SampleStream* stream,
                 uint* rays) {
+    float2 u = sample_2d(stream, DIM_LIGHT);
+    /* The sky light of --sky is one more light, chosen with the probability the built-in light
+     * strategies give it (scene->env.sky_pmf: 1/2 beside area lights, 1 alone; 0 without --sky,
+     * when nothing here changes), its direction cosine-weighted about the normal. */
+    float sky_pmf = scene->env.sky_pmf;
+    if (sky_pmf > 0.0f && u.x < sky_pmf) {
+        float3 w = sample_hemisphere_cosine((float2)(fmin(u.x / sky_pmf, 0x1.fffffep-1f), u.y));
+        float pdf_w = sample_hemisphere_cosine_pdf_w(w);
+        if (!(pdf_w > 0.0f)) return (float3)(0.0f);
+        Frame frame = frame_from_normal(sp->n);
+        float3 wi = frame_to_world(&frame, w);
+        if (!escapes(scene, sp, wi, MAXFLOAT, rays)) return (float3)(0.0f);
+        return bsdf_eval(sp, wi) * scene->env.sky * (w.z / (pdf_w * sky_pmf));
+    }
+    if (sky_pmf > 0.0f) u.x = fmin((u.x - sky_pmf) / (1.0f - sky_pmf), 0x1.fffffep-1f);
+
     uint n = scene->lights.light_count;
     if (n == 0u) return (float3)(0.0f);
 
@@ -54,7 +71,6 @@ float3 estimate(const SceneView* scene, const SurfacePoint* sp, const SampleStre
         total += light_importance(sp, &light);
     }
     if (!(total > 0.0f)) return (float3)(0.0f); /* no light can reach this point */
-    float2 u = sample_2d(stream, DIM_LIGHT);
     float target = u.x * total;
     uint chosen = n;
     float w_chosen = 0.0f, running = 0.0f, start = 0.0f;
@@ -68,7 +84,7 @@ float3 estimate(const SceneView* scene, const SurfacePoint* sp, const SampleStre
         running += w;
         if (target < running) break;
     }
-    float pmf = w_chosen / total;
+    float pmf = w_chosen / total * (1.0f - sky_pmf); /* the area lights share 1 − sky_pmf */
     /* Where target fell in the chosen light's share, rescaled: uniform again, for the point. */
     float u_remap = clamp((target - start) / w_chosen, 0.0f, 0x1.fffffep-1f);
 
