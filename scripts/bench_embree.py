@@ -65,7 +65,7 @@ def main():
           f"1-minute load average {min(loads):.1f}-{max(loads):.1f}")
     print()
     print("| scene (triangles) | rays | count | mcrt Mrays/s | Embree Mrays/s | ratio (min-max) "
-          "| hit mismatches | triangle mismatches | mcrt build (s) | Embree build (s) "
+          "| hit mismatches | triangle mismatches (all / at another distance) | mcrt build (s) | Embree build (s) "
           "| SAH cost | packets | bytes/triangle |")
     print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for s in args.scenes:
@@ -78,7 +78,10 @@ def main():
                      f"{med(j['embree_build_seconds'] for j in js):.3f} | "
                      f"{js[0]['sah_cost']:.2f} | {js[0].get('bvh_packets', '-')} | "
                      f"{js[0]['bytes_per_triangle']:.1f}") if first else "| | | |"
-            tri = str(max(j.get("triangle_mismatches", 0) for j in js)) \
+            # Other triangles, and (after the slash) those of them at another distance: the
+            # rest are ties between coplanar or edge-sharing triangles.
+            tri = "%d / %d" % (max(j.get("triangle_mismatches", 0) for j in js),
+                               max(j.get("triangle_mismatches_apart", 0) for j in js)) \
                 if kind == "primary" else "-"
             print(f"| {name} | {kind} | {js[0]['count']:,} | "
                   f"{med(j['mrays_per_s'] for j in js):.2f} | "

@@ -141,6 +141,16 @@ TEST_CASE("bench --bvh-max-leaf and --bvh-traversal-cost shape the tree, not the
     CHECK(free_nodes["bvh_nodes"].get<long long>() > standard["bvh_nodes"].get<long long>());
     CHECK(single["hits"] == standard["hits"]);
     CHECK(free_nodes["hits"] == standard["hits"]);
+#ifdef MCRT_HAVE_EMBREE
+    // Leaves of one triangle resolve the box's coplanar triangles (its light and ceiling) in
+    // another order than Embree: other triangles, but always at Embree's distance.
+    for (const auto* j : {&standard, &single, &free_nodes}) {
+        REQUIRE(j->contains("triangle_mismatches_apart"));
+        CHECK((*j)["triangle_mismatches_apart"] == 0);
+        CHECK((*j)["triangle_mismatches_apart"].get<long long>() <=
+              (*j)["triangle_mismatches"].get<long long>());
+    }
+#endif
 }
 
 TEST_CASE("bench rejects bad input with exit status 2", "[bench]") {

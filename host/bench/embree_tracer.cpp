@@ -119,8 +119,10 @@ EmbreeTracer::~EmbreeTracer() {
     if (device_) rtcReleaseDevice(device_);
 }
 
-void EmbreeTracer::closest(const RayBatch& rays, std::vector<uint32_t>* triangle) const {
+void EmbreeTracer::closest(const RayBatch& rays, std::vector<uint32_t>* triangle,
+                           std::vector<float>* t) const {
     triangle->resize(rays.size());
+    if (t) t->resize(rays.size());
     parallel_chunks(rays.size(), threads_, [&](size_t begin, size_t end) {
         RTCIntersectContext context;
         rtcInitIntersectContext(&context);
@@ -132,6 +134,7 @@ void EmbreeTracer::closest(const RayBatch& rays, std::vector<uint32_t>* triangle
             rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
             rtcIntersect1(scene_, &context, &rh);
             (*triangle)[k] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? UINT32_MAX : rh.hit.primID;
+            if (t) (*t)[k] = rh.ray.tfar;
         }
     });
 }

@@ -30,8 +30,10 @@ class EmbreeTracer {
     unsigned threads() const { return threads_; }
     std::string version() const;  // "3.13.5"
 
-    // Closest hit of every ray in (0, t_max): the scene triangle index, or UINT32_MAX on a miss.
-    void closest(const RayBatch& rays, std::vector<uint32_t>* triangle) const;
+    // Closest hit of every ray in (0, t_max): the scene triangle index, or UINT32_MAX on a miss;
+    // with `t`, also the hit distance (t_max on a miss).
+    void closest(const RayBatch& rays, std::vector<uint32_t>* triangle,
+                 std::vector<float>* t = nullptr) const;
     // 1 where something blocks the ray in (0, t_max), else 0.
     void occluded(const RayBatch& rays, std::vector<uint8_t>* blocked) const;
 
