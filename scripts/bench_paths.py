@@ -48,6 +48,8 @@ def main():
             r = mcrt_run.render(scene, Path(scratch) / "m", [
                 "--width", args.width, "--height", args.height, "--spp", args.spp,
                 "--max-depth", args.depth, "--estimator", "mis",
+                # Mitsuba's MIS weights are the power heuristic's; mcrt's default is balance.
+                "--mis-heuristic", "power",
                 # Mitsuba's conversion is diffuse (mitsuba_reference.py --materials lambert).
                 "--materials", "lambert"] + sky, mcrt=args.mcrt,
                 read_image=False)
