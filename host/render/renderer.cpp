@@ -113,6 +113,15 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
                     if (!item) {
                         size_t depth = worker.report.batches == 0 ? 1 : worker.pipeline_depth();
                         if (started.size() >= depth) break;
+                        // Under a time limit, no second launch that would only start after it:
+                        // it would run past the limit whole (the stop lets started work drain).
+                        if (!started.empty() && control.time_limit > 0) {
+                            double per_batch =
+                                worker.report.seconds_busy / double(worker.report.batches);
+                            if (seconds_since(start) + double(started.size()) * per_batch >=
+                                control.time_limit)
+                                break;
+                        }
                         item = queue.take(worker.target_samples(), started.empty());
                         if (!item) break;
                     }
