@@ -122,9 +122,14 @@ def rmse(image, ref, ref_variance, keep):
 
 def mean_difference(a, b, keep):
     """(mean of a, mean of b, relative difference of the means, its standard error) of two
-    Accumulators over the pixels `keep`; the error None with one round."""
+    Accumulators over the pixels `keep`; the error None with one round; nan where no pixel is
+    kept (a scene whose every surface emits) or b's mean is 0."""
+    if not keep.any():
+        return float("nan"), float("nan"), float("nan"), None
     mean_a, mean_b = float(a.mean()[keep].mean()), float(b.mean()[keep].mean())
     variance = (a.variance_of_mean() + b.variance_of_mean())[keep]
+    if mean_b == 0.0:
+        return mean_a, mean_b, float("nan"), None
     stderr = math.sqrt(float(variance.sum())) / variance.size / mean_b if a.n > 1 else None
     return mean_a, mean_b, (mean_a - mean_b) / mean_b, stderr
 
