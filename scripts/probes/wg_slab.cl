@@ -11,6 +11,24 @@
  *   slab_float4: one work-item per ray with float4 arithmetic over the four children, as
  *                mcrt traverses today. */
 
+/* The entered children of one node (bit c for child c), scalar code as a work-item loop
+ * vectorises it: the arithmetic of bvh4_entry, one child at a time. */
+inline uint slab_mask(global const float* f, float ox, float oy, float oz, float ix, float iy,
+                      float iz, bool nx, bool ny, bool nz, float t_max) {
+    uint m = 0u;
+    for (int c = 0; c < 4; ++c) {
+        float lx = f[c], hx = f[4 + c], ly = f[8 + c], hy = f[12 + c], lz = f[16 + c],
+              hz = f[20 + c];
+        float tnx = ((nx ? hx : lx) - ox) * ix, tfx = ((nx ? lx : hx) - ox) * ix;
+        float tny = ((ny ? hy : ly) - oy) * iy, tfy = ((ny ? ly : hy) - oy) * iy;
+        float tnz = ((nz ? hz : lz) - oz) * iz, tfz = ((nz ? lz : hz) - oz) * iz;
+        float t_enter = max(max(tnx, tny), max(tnz, 0.0f));
+        float t_exit = min(min(min(tfx, tfy), tfz) * 1.0000004f, t_max);
+        m |= (t_enter <= t_exit ? 1u : 0u) << c;
+    }
+    return m;
+}
+
 __attribute__((reqd_work_group_size(64, 1, 1)))
 kernel void slab_group(global const float* nodes, global const float4* org,
                        global const float4* inv, global uint* out, uint node_count) {
@@ -24,17 +42,7 @@ kernel void slab_group(global const float* nodes, global const float4* org,
     uint acc = 0u;
     for (uint k = 0; k < node_count; ++k) {
         global const float* f = nodes + 24 * k; /* lo_x[4], hi_x[4], lo_y, hi_y, lo_z, hi_z */
-        uint m = 0u;
-        for (int c = 0; c < 4; ++c) {
-            float lx = f[c], hx = f[4 + c], ly = f[8 + c], hy = f[12 + c], lz = f[16 + c],
-                  hz = f[20 + c];
-            float tnx = ((nx ? hx : lx) - ox) * ix, tfx = ((nx ? lx : hx) - ox) * ix;
-            float tny = ((ny ? hy : ly) - oy) * iy, tfy = ((ny ? ly : hy) - oy) * iy;
-            float tnz = ((nz ? hz : lz) - oz) * iz, tfz = ((nz ? lz : hz) - oz) * iz;
-            float t_enter = max(max(tnx, tny), max(tnz, 0.0f));
-            float t_exit = min(min(min(tfx, tfy), tfz) * 1.0000004f, t_max);
-            m |= (t_enter <= t_exit ? 1u : 0u) << c;
-        }
+        uint m = slab_mask(f, ox, oy, oz, ix, iy, iz, nx, ny, nz, t_max);
         masks[lid] = m;
         barrier(CLK_LOCAL_MEM_FENCE);
         if (lid == 0u) {
@@ -60,17 +68,7 @@ kernel void slab_barrier(global const float* nodes, global const float4* org,
     uint acc = 0u;
     for (uint k = 0; k < node_count; ++k) {
         global const float* f = nodes + 24 * k; /* lo_x[4], hi_x[4], lo_y, hi_y, lo_z, hi_z */
-        uint m = 0u;
-        for (int c = 0; c < 4; ++c) {
-            float lx = f[c], hx = f[4 + c], ly = f[8 + c], hy = f[12 + c], lz = f[16 + c],
-                  hz = f[20 + c];
-            float tnx = ((nx ? hx : lx) - ox) * ix, tfx = ((nx ? lx : hx) - ox) * ix;
-            float tny = ((ny ? hy : ly) - oy) * iy, tfy = ((ny ? ly : hy) - oy) * iy;
-            float tnz = ((nz ? hz : lz) - oz) * iz, tfz = ((nz ? lz : hz) - oz) * iz;
-            float t_enter = max(max(tnx, tny), max(tnz, 0.0f));
-            float t_exit = min(min(min(tfx, tfy), tfz) * 1.0000004f, t_max);
-            m |= (t_enter <= t_exit ? 1u : 0u) << c;
-        }
+        uint m = slab_mask(f, ox, oy, oz, ix, iy, iz, nx, ny, nz, t_max);
         masks[lid] = m;
         barrier(CLK_LOCAL_MEM_FENCE);
         acc += masks[(lid + 1u) & 63u] + m;
