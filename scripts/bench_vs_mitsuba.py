@@ -21,8 +21,9 @@ when mitsuba is not importable). Per scene and pair: one untimed warm-up render 
 PoCL kernel cache; Mitsuba: its JIT), then --rounds rounds of one `mcrt render` (its time: the
 stats' seconds_render_wall, the render's wall clock from the first launch, after the kernel build
 and upload; the kernels' own time and the process's wall time recorded too) and one
-mi.render(scene, spp=N, seed=round) timed with time.monotonic up to the numpy copy that forces
-its evaluation. Samples per second = width·height·spp / seconds: median and range over the
+mi.render(scene, spp=N, seed=S) timed with time.monotonic up to the numpy copy that forces
+its evaluation; S, also mcrt's --seed, is the round plus R times the pair's index, so that no two
+pairs share random numbers. Samples per second = width·height·spp / seconds: median and range over the
 rounds, and the ratio of the medians.
 
 Error: each side's last image against one reference per scene and pair, an mcrt render of the
@@ -60,7 +61,7 @@ import numpy as np  # noqa: E402
 
 PAIRS = ("mis", "light-area", "path")
 RR_DEPTH = 5
-WARMUP_SEED, REFERENCE_SEED = 1000, 1000003  # apart from the rounds' seeds 0 .. R−1
+WARMUP_SEED, REFERENCE_SEED = 1000, 1000003  # apart from the rounds' seeds 0 .. 3R−1 (R < 333)
 
 
 def mcrt_options(pair, depth, sky):
@@ -192,10 +193,15 @@ def bench(args, mi, item, pair, scratch):
     warmup = {"mcrt_wall_seconds": warm.wall_seconds, "mitsuba_seconds": time.monotonic() - start}
 
     rounds, mcrt_images, mitsuba_images = [], Accumulator(), Accumulator()
+    # Each pair its own seeds: with the same seeds 0 .. R−1 everywhere, the pairs of a scene
+    # drew the same random numbers (common random numbers), and their image means' differences
+    # were one draw shown six times (docs/BENCHMARKS.md, session 6).
+    first_seed = PAIRS.index(pair) * args.rounds
     for r in range(args.rounds):
-        m = mcrt_run.render(scene, stem, options + ["--seed", r], mcrt=args.mcrt)
+        seed = first_seed + r
+        m = mcrt_run.render(scene, stem, options + ["--seed", seed], mcrt=args.mcrt)
         start = time.monotonic()
-        image = np.array(mi.render(m_scene, spp=args.spp, seed=r), dtype=np.float64)[..., :3]
+        image = np.array(mi.render(m_scene, spp=args.spp, seed=seed), dtype=np.float64)[..., :3]
         seconds = time.monotonic() - start
         mcrt_image = np.moveaxis(m.rgb, 0, -1)
         mcrt_images.add(mcrt_image)
@@ -302,6 +308,8 @@ def main():
                         ("--reference-spp", args.reference_spp)):
         if value < 1:
             raise mcrt_run.ScriptError("%s must be at least 1, not %d" % (name, value))
+    if 3 * args.rounds > WARMUP_SEED:
+        raise mcrt_run.ScriptError("--rounds must be at most %d" % (WARMUP_SEED // 3))
     for pair in args.pairs:
         if pair not in PAIRS:
             raise mcrt_run.ScriptError("unknown pair %s (one of %s)" % (pair, ", ".join(PAIRS)))
