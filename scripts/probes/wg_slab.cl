@@ -13,8 +13,9 @@
 
 /* The entered children of one node (bit c for child c), scalar code as a work-item loop
  * vectorises it: the arithmetic of bvh4_entry, one child at a time. */
-inline uint slab_mask(global const float* f, float ox, float oy, float oz, float ix, float iy,
-                      float iz, bool nx, bool ny, bool nz, float t_max) {
+inline uint slab_mask(global const float* f, float4 o, float4 iv) {
+    float ox = o.x, oy = o.y, oz = o.z, ix = iv.x, iy = iv.y, iz = iv.z, t_max = o.w;
+    bool nx = ix < 0.0f, ny = iy < 0.0f, nz = iz < 0.0f;
     uint m = 0u;
     for (int c = 0; c < 4; ++c) {
         float lx = f[c], hx = f[4 + c], ly = f[8 + c], hy = f[12 + c], lz = f[16 + c],
@@ -35,14 +36,11 @@ kernel void slab_group(global const float* nodes, global const float4* org,
     uint lid = get_local_id(0), g = get_global_id(0);
     local uint masks[64];
     local uint vote;
-    float4 o = org[g], iv = inv[g];
-    float ox = o.x, oy = o.y, oz = o.z, ix = iv.x, iy = iv.y, iz = iv.z;
-    bool nx = ix < 0.0f, ny = iy < 0.0f, nz = iz < 0.0f;
-    float t_max = o.w;
+    float4 o = org[g], iv = inv[g]; /* t_max in o.w */
     uint acc = 0u;
     for (uint k = 0; k < node_count; ++k) {
-        global const float* f = nodes + 24 * k; /* lo_x[4], hi_x[4], lo_y, hi_y, lo_z, hi_z */
-        uint m = slab_mask(f, ox, oy, oz, ix, iy, iz, nx, ny, nz, t_max);
+        /* lo_x[4], hi_x[4], lo_y, hi_y, lo_z, hi_z */
+        uint m = slab_mask(nodes + 24 * k, o, iv);
         masks[lid] = m;
         barrier(CLK_LOCAL_MEM_FENCE);
         if (lid == 0u) {
@@ -61,14 +59,11 @@ kernel void slab_barrier(global const float* nodes, global const float4* org,
                        global const float4* inv, global uint* out, uint node_count) {
     uint lid = get_local_id(0), g = get_global_id(0);
     local uint masks[64];
-    float4 o = org[g], iv = inv[g];
-    float ox = o.x, oy = o.y, oz = o.z, ix = iv.x, iy = iv.y, iz = iv.z;
-    bool nx = ix < 0.0f, ny = iy < 0.0f, nz = iz < 0.0f;
-    float t_max = o.w;
+    float4 o = org[g], iv = inv[g]; /* t_max in o.w */
     uint acc = 0u;
     for (uint k = 0; k < node_count; ++k) {
-        global const float* f = nodes + 24 * k; /* lo_x[4], hi_x[4], lo_y, hi_y, lo_z, hi_z */
-        uint m = slab_mask(f, ox, oy, oz, ix, iy, iz, nx, ny, nz, t_max);
+        /* lo_x[4], hi_x[4], lo_y, hi_y, lo_z, hi_z */
+        uint m = slab_mask(nodes + 24 * k, o, iv);
         masks[lid] = m;
         barrier(CLK_LOCAL_MEM_FENCE);
         acc += masks[(lid + 1u) & 63u] + m;
