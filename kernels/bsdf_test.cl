@@ -8,11 +8,12 @@
 
 inline SurfacePoint test_surface(float4 albedo, float4 Le, float4 specular, float3 wo) {
     SurfacePoint sp;
-    sp.p = (float3)(0.0f);
+    sp.p = sp.p_error = (float3)(0.0f);
     sp.n = (float3)(0.0f, 0.0f, 1.0f);
     sp.wo = wo;
     sp.front = true;
     sp.light = 0u;
+    sp.lane = MCRT_NO_HIT;
     sp.material.albedo = albedo;
     sp.material.Le = Le;
     sp.material.specular = specular;

@@ -67,11 +67,31 @@ inline float4 bvh4_entry(global const Bvh4Node* node, const BoxRay* b, float t_m
     return select((float4)(MAXFLOAT), t_enter, t_enter <= t_exit);
 }
 
-/* Closest hit with t in (0, t_max). Children are visited nearest first; the others wait on the
+/* The packet and lane mask of the triangle a ray leaves (a packet lane, 4 · packet + lane, or
+ * MCRT_NO_HIT for none), which the traversal never reports: a flat triangle cannot be hit
+ * again by a ray leaving it, so skipping it is exact. */
+typedef struct {
+    uint packet;
+    int4 lanes;
+} SkipLane;
+
+inline SkipLane make_skip_lane(uint lane) {
+    SkipLane s;
+    s.packet = lane == MCRT_NO_HIT ? MCRT_NO_HIT : lane / MCRT_PACKET_WIDTH;
+    s.lanes = (int4)(0, 1, 2, 3) == (int4)((int)(lane % MCRT_PACKET_WIDTH));
+    return s;
+}
+
+inline int4 skipped_lanes(const SkipLane* s, uint packet) {
+    return packet == s->packet ? s->lanes : (int4)(0);
+}
+
+/* Closest hit with t in (δt, t_max) (intersect.cl), never on the triangle at packet lane `skip`
+ * (MCRT_NO_HIT: none). Children are visited nearest first; the others wait on the
  * stack with their entry distances and are skipped once a nearer hit is found. An empty scene's
  * root has only empty slots, so no ray enters it. */
 inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePacket* packets,
-                           const Ray* r, float t_max) {
+                           const Ray* r, float t_max, uint skip) {
     Hit hit;
     hit.t = t_max;
     hit.b1 = hit.b2 = 0.0f;
@@ -79,6 +99,7 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePa
 
     BoxRay b = make_box_ray(r);
     PacketRay q = make_packet_ray(r);
+    SkipLane s = make_skip_lane(skip);
     /* One spare entry at the end takes the writes of children that are not pushed. */
     uint stack_ref[BVH_STACK_SIZE + 1], stack_count[BVH_STACK_SIZE + 1];
     float stack_t[BVH_STACK_SIZE + 1];
@@ -126,7 +147,9 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePa
             global const TrianglePacket* pk = packets + ref;
             for (uint k = 0; k < count; k += MCRT_PACKET_WIDTH, ++pk) {
                 float4 t4 = (float4)(0.0f), b1 = (float4)(0.0f), b2 = (float4)(0.0f);
-                int4 lanes = intersect_packet(&q, pk, hit.t, &t4, &b1, &b2);
+                uint packet = ref + k / MCRT_PACKET_WIDTH;
+                int4 lanes = intersect_packet(&q, pk, hit.t, skipped_lanes(&s, packet), false,
+                                              &t4, &b1, &b2);
                 /* The nearest hit lane, the first of equals (leaf order, as one triangle at a time
                  * would take them), by compares instead of a loop over private arrays; taken by
                  * selects, not a branch on whether any lane hit (which mispredicted). A lane hits
@@ -138,7 +161,7 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePa
                 bool nearer = m < hit.t;
                 float hb1 = i == 0 ? b1.x : i == 1 ? b1.y : i == 2 ? b1.z : b1.w;
                 float hb2 = i == 0 ? b2.x : i == 1 ? b2.y : i == 2 ? b2.z : b2.w;
-                uint lane = MCRT_PACKET_WIDTH * (ref + k / MCRT_PACKET_WIDTH) + (uint)i;
+                uint lane = MCRT_PACKET_WIDTH * packet + (uint)i;
                 hit.t = nearer ? m : hit.t;
                 hit.b1 = nearer ? hb1 : hit.b1;
                 hit.b2 = nearer ? hb2 : hit.b2;
@@ -156,16 +179,19 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePa
     }
 }
 
-/* True if anything blocks the ray in (0, t_max). Leaves are tested as soon as their box is
+/* True if anything but the triangle at packet lane `skip` (MCRT_NO_HIT: none) blocks the ray
+ * in (δt, t_max − δt), each hit's δt its own rounding bound (intersect.cl): a hit that rounding
+ * may have put at either end of the segment does not block it. Leaves are tested as soon as their box is
  * entered (any hit ends the search); inner children go on the stack. Slots are taken from the
  * last to the first, so that slot 0 (the binary tree's leftmost child) is popped first: on the
  * bench's shadow rays this visited 6.7 nodes per ray in Sponza against 9.7 in slot order and 9.0
  * nearest first, but 8.3 against 5.5 in the modern hall (docs/BENCHMARKS.md, issue 6). No order
  * wins everywhere; this one gave the best worst-case ratio to Embree over the bench scenes. */
 inline bool bvh_any_hit(global const Bvh4Node* nodes, global const TrianglePacket* packets,
-                        const Ray* r, float t_max) {
+                        const Ray* r, float t_max, uint skip) {
     BoxRay b = make_box_ray(r);
     PacketRay q = make_packet_ray(r);
+    SkipLane sk = make_skip_lane(skip);
     uint stack[BVH_STACK_SIZE];
     int sp = 0;
     uint ref = 0u;
@@ -183,7 +209,9 @@ inline bool bvh_any_hit(global const Bvh4Node* nodes, global const TrianglePacke
             global const TrianglePacket* pk = packets + child;
             for (uint k = 0; k < count; k += MCRT_PACKET_WIDTH, ++pk) {
                 float4 t4, b1, b2;
-                if (any(intersect_packet(&q, pk, t_max, &t4, &b1, &b2))) return true;
+                int4 skipped = skipped_lanes(&sk, child + k / MCRT_PACKET_WIDTH);
+                if (any(intersect_packet(&q, pk, t_max, skipped, true, &t4, &b1, &b2)))
+                    return true;
             }
         }
         if (sp == 0) return false;

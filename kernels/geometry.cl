@@ -38,21 +38,39 @@ inline Ray make_ray(float3 org, float3 dir) {
     return r;
 }
 
-/* Wächter & Binder 2019, "A Fast and Robust Method for Avoiding Self-Intersection" (Ray Tracing
- * Gems, ch. 6): move p along n by a few ulps, scaled to p's magnitude, not by a fixed epsilon. */
-inline float offset_component(float p, float n) {
-    const float origin = 1.0f / 32.0f;
-    const float float_scale = 1.0f / 65536.0f;
-    const float int_scale = 256.0f;
-    int of = (int)(int_scale * n);
-    float p_i = as_float(as_int(p) + (p < 0.0f ? -of : of));
-    return fabs(p) < origin ? p + float_scale * n : p_i;
+/* γ(n) = nε / (1 − nε), ε = 2^-24: a bound on the relative error of n successive float roundings
+ * (PBRT 4th ed., sec. 6.8.1, "Floating-point arithmetic"). A constant expression. */
+#define MCRT_GAMMA(n) ((float)(n) * 0x1.0p-24f / (1.0f - (float)(n) * 0x1.0p-24f))
+
+/* Per-component bound on the rounding error of a point p0 + b1·e1 + b2·e2 computed in float
+ * from its triangle's vertices (e1 = p1 − p0 and e2 = p2 − p0 rounded once each), given the
+ * products b1·e1 and b2·e2: each of the three terms carries at most four roundings (the edge,
+ * the product, two sums; a fused multiply-add only removes one), so γ(5)·(|p0| + |b1·e1| +
+ * |b2·e2|) bounds it (PBRT 4th ed., sec. 6.8.5, "Bounding intersection point error", for the
+ * form b0·p0 + b1·p1 + b2·p2). What it bounds is the distance from the triangle's own plane:
+ * the barycentrics' errors move the point within that plane only. It grows with the vertices'
+ * magnitudes, not the point's: a point near the origin on a 2 km floor is as uncertain as the
+ * floor's corners. */
+inline float3 interpolation_error(float3 p0, float3 b1_e1, float3 b2_e2) {
+    return MCRT_GAMMA(5) * (fabs(p0) + fabs(b1_e1) + fabs(b2_e2));
 }
 
-/* n must be the geometric normal on the side the new ray leaves from. */
-inline float3 offset_ray_origin(float3 p, float3 n) {
-    return (float3)(offset_component(p.x, n.x), offset_component(p.y, n.y),
-                    offset_component(p.z, n.z));
+/* The origin of a ray leaving the point p (per-component error bound p_error) on the side of
+ * n, its surface's unit geometric normal on that side: p moved along n by d = |n|·p_error,
+ * which puts every point p_error allows on that side of the surface's plane, then each moved
+ * component rounded one float further from p, so that the sum's own rounding cannot bring it
+ * back (PBRT 4th ed., sec. 6.8.6, "Robust spawned ray origins", OffsetRayOrigin). Where the
+ * point is exact (p_error 0, as on a floor at y = 0), the origin stays on the plane: the
+ * traversal skips the triangle the ray leaves, and the intersection test accepts only
+ * distances beyond its own rounding (intersect.cl), so neither the triangle nor a coplanar
+ * neighbour is hit again. */
+inline float3 offset_ray_origin(float3 p, float3 p_error, float3 n) {
+    float d = dot(fabs(n), p_error);
+    float3 offset = d * n;
+    float3 po = p + offset;
+    po = select(po, nextafter(po, (float3)(INFINITY)), offset > (float3)(0.0f));
+    po = select(po, nextafter(po, (float3)(-INFINITY)), offset < (float3)(0.0f));
+    return po;
 }
 
 #endif

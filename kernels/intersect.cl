@@ -42,13 +42,19 @@ inline PacketRay make_packet_ray(const Ray* r) {
  * depend on its packet): translate to the ray origin, permute so that z is the dominant axis,
  * shear (sec. 3); scaled barycentrics as 2D edge functions, recomputed in double when one is an
  * exact zero, which may be a rounding artefact on a shared edge; the scaled hit distance compared
- * before dividing. Returns a lane mask (-1 where a used lane is hit with t in (0, t_max)) and the
- * lanes' t and barycentrics b1, b2 of vertices 1 and 2. Forced inline: PoCL's inliner prices it
- * just over its threshold (565 against 562) and called it, which cost the closest hit about 10%
- * (docs/BENCHMARKS.md, issue 16). */
+ * before dividing. A hit counts only where its distance is beyond its own rounding error δt
+ * (PBRT 4th ed., sec. 6.8.7, "Avoiding intersections behind ray origins"): t > δt, so that a ray
+ * leaving a surface cannot hit that surface's plane again however large its triangles; and with
+ * `conservative_far` (occlusion queries) also t + δt < t_max, so that a shadow ray aimed at a
+ * point on a light is not stopped by the light's own plane. Lanes set in `skip` (the triangle a
+ * ray leaves: a flat triangle cannot be hit again by a ray leaving it) never hit. Returns a lane
+ * mask (-1 where a used lane is hit with t in (δt, t_max)) and the lanes' t and barycentrics
+ * b1, b2 of vertices 1 and 2. Forced inline: PoCL's inliner prices it just over its threshold
+ * (565 against 562) and called it, which cost the closest hit about 10% (docs/BENCHMARKS.md). */
 inline __attribute__((always_inline)) int4 intersect_packet(const PacketRay* q,
                                                             global const TrianglePacket* pk,
-                                                            float t_max, float4* t_hit,
+                                                            float t_max, int4 skip,
+                                                            bool conservative_far, float4* t_hit,
                                                             float4* b1, float4* b2) {
     global const float4* v = pk->v;
     float4 a_x = v[q->kx] - q->org_x, a_y = v[q->ky] - q->org_y, a_z = v[q->kz] - q->org_z;
@@ -63,7 +69,7 @@ inline __attribute__((always_inline)) int4 intersect_packet(const PacketRay* q,
     float4 u = cx * by - cy * bx;
     float4 w_ = bx * ay - by * ax;
     float4 v_ = ax * cy - ay * cx;
-    int4 used = as_int4(vload4(0, pk->index)) != (int4)(-1);
+    int4 used = (as_int4(vload4(0, pk->index)) != (int4)(-1)) & ~skip;
 #ifdef MCRT_HAVE_FP64
     int4 zero = used & ((u == 0.0f) | (v_ == 0.0f) | (w_ == 0.0f));
     if (any(zero)) {
@@ -85,7 +91,22 @@ inline __attribute__((always_inline)) int4 intersect_packet(const PacketRay* q,
     float4 t_scaled = u * az + v_ * bz + w_ * cz;
     float4 inv_det = 1.0f / det;
     float4 t = t_scaled * inv_det;
-    hit &= (t > 0.0f) & (t < (float4)(t_max));
+
+    /* δt, PBRT 4th ed. sec. 6.8.7: the errors of the translated and sheared coordinates (δx, δy,
+     * δz), of the edge functions (δe) and of t_scaled, over |det|. */
+    float4 max_zt = max(fabs(az), max(fabs(bz), fabs(cz)));
+    float4 max_xt = max(fabs(ax), max(fabs(bx), fabs(cx)));
+    float4 max_yt = max(fabs(ay), max(fabs(by), fabs(cy)));
+    float4 delta_z = MCRT_GAMMA(3) * max_zt;
+    float4 delta_x = MCRT_GAMMA(5) * (max_xt + max_zt);
+    float4 delta_y = MCRT_GAMMA(5) * (max_yt + max_zt);
+    float4 delta_e = 2.0f * (MCRT_GAMMA(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+    float4 max_e = max(fabs(u), max(fabs(v_), fabs(w_)));
+    float4 delta_t = 3.0f *
+                     (MCRT_GAMMA(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) *
+                     fabs(inv_det);
+    float4 t_end = conservative_far ? (float4)(t_max) - delta_t : (float4)(t_max);
+    hit &= (t > delta_t) & (t < t_end);
     *t_hit = t;
     *b1 = v_ * inv_det;
     *b2 = w_ * inv_det;

@@ -22,6 +22,7 @@
 typedef struct {
     float3 wi;       /* unit, from the shading point toward y */
     float3 y;        /* the sampled point on the light */
+    float3 y_error;  /* per-component bound on y's distance from the light's plane */
     float3 n_toward; /* the light's geometric normal on the shading point's side (ray offset) */
     float3 Le;       /* radiance the light emits toward the shading point */
     float pmf;       /* probability of having chosen this light */
@@ -35,7 +36,7 @@ typedef struct {
 
 inline LightSample no_light_sample(void) {
     LightSample ls;
-    ls.wi = ls.y = ls.n_toward = ls.Le = (float3)(0.0f);
+    ls.wi = ls.y = ls.y_error = ls.n_toward = ls.Le = (float3)(0.0f);
     ls.pmf = ls.pdf = ls.d2 = ls.cos_light = 0.0f;
     ls.measure = LIGHT_MEASURE_AREA;
     ls.light = 0u;
@@ -129,6 +130,7 @@ inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint*
     if (cos_y <= 0.0f) return ls; /* the light's back face */
     ls.wi = wi;
     ls.y = lp.p;
+    ls.y_error = lp.p_error;
     ls.n_toward = dot(n_light, wi) < 0.0f ? n_light : -n_light;
     ls.Le = light.Le.xyz;
     ls.pmf = choice.pmf * area_lights_pmf(scene);
@@ -165,16 +167,23 @@ inline LightSample sample_light_solid_angle(const SceneView* scene, const Surfac
     float3 a = normalize(light.p0.xyz - x), b = normalize(light.p1.xyz - x),
            c = normalize(light.p2.xyz - x);
     float omega = spherical_triangle_solid_angle(a, b, c);
-    float3 wi, y;
+    float3 wi, y, y_error;
     float pdf_w;
     if (omega > MIN_SPHERICAL_SOLID_ANGLE && omega < MAX_SPHERICAL_SOLID_ANGLE) {
         wi = sample_spherical_triangle_omega(a, b, c, omega, u);
         pdf_w = 1.0f / omega;
         /* Where the direction meets the light's plane. */
+        float3 to_p0 = light.p0.xyz - x;
         float denom = dot(wi, n_light);
-        float t = dot(light.p0.xyz - x, n_light) / denom;
+        float t = dot(to_p0, n_light) / denom;
         if (!(t > 0.0f) || !isfinite(t)) return ls;
-        y = x + t * wi;
+        float3 t_wi = t * wi;
+        y = x + t_wi;
+        /* y's distance from the plane: the numerator's rounding (γ(4)·|p0 − x|·|n|) and the
+         * denominator's (γ(3)·|t·wi|·|n|) reach it through t·denom, the last sum's two roundings
+         * add γ(2)·(|x| + |t·wi|), and the normal's own rounding tilts the plane about p0 by
+         * γ(4)·|y − p0|, bounded by |p0 − x| + |t·wi|. */
+        y_error = MCRT_GAMMA(8) * (fabs(x) + fabs(t_wi) + fabs(to_p0));
     } else {
         LightPoint lp = sample_light_point(&light, u);
         float3 to_light = lp.p - x;
@@ -185,12 +194,14 @@ inline LightSample sample_light_solid_angle(const SceneView* scene, const Surfac
         if (cos_y <= 0.0f) return ls;
         pdf_w = pdf_area_to_solid_angle(lp.pdf_a, d2, cos_y);
         y = lp.p;
+        y_error = lp.p_error;
     }
     float cos_y = light_emitting_cosine(&light, n_light, wi);
     if (cos_y <= 0.0f) return ls;
     float3 d = y - x;
     ls.wi = wi;
     ls.y = y;
+    ls.y_error = y_error;
     ls.n_toward = dot(n_light, wi) < 0.0f ? n_light : -n_light;
     ls.Le = light.Le.xyz;
     ls.pmf = choice.pmf * area_lights_pmf(scene);
@@ -225,10 +236,10 @@ inline float light_sample_pdf_w(const LightSample* ls) {
 inline bool light_sample_visible(const SceneView* scene, const SurfacePoint* sp,
                                  const LightSample* ls) {
     if (ls->light == LIGHT_SKY) { /* nothing along the ray to infinity */
-        Ray r = make_ray(offset_ray_origin(sp->p, sp->n), ls->wi);
-        return !bvh_any_hit(scene->nodes, scene->packets, &r, MAXFLOAT);
+        Ray r = make_ray(spawn_origin(sp), ls->wi);
+        return !bvh_any_hit(scene->nodes, scene->packets, &r, MAXFLOAT, sp->lane);
     }
-    return visible(scene, sp->p, sp->n, ls->y, ls->n_toward);
+    return visible(scene, sp, ls->y, ls->y_error, ls->n_toward);
 }
 
 /* ---- The twins: densities of a direction wi from sp that hit the light at `seen` ------------- */

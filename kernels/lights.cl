@@ -61,7 +61,8 @@ inline float3 light_normal(const Light* light) {
 }
 
 typedef struct {
-    float3 p; /* point on the light */
+    float3 p;       /* point on the light */
+    float3 p_error; /* per-component bound on p's distance from the light's plane */
     float pdf_a;
 } LightPoint;
 
@@ -70,7 +71,9 @@ inline LightPoint sample_light_point(const Light* light, float2 u) {
     float2 b = sample_triangle_uniform(u);
     float3 p0 = light->p0.xyz;
     LightPoint lp;
-    lp.p = p0 + b.x * (light->p1.xyz - p0) + b.y * (light->p2.xyz - p0);
+    float3 b1_e1 = b.x * (light->p1.xyz - p0), b2_e2 = b.y * (light->p2.xyz - p0);
+    lp.p = p0 + b1_e1 + b2_e2;
+    lp.p_error = interpolation_error(p0, b1_e1, b2_e2);
     lp.pdf_a = sample_triangle_uniform_pdf_a(light_area(light));
     return lp;
 }

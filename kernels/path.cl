@@ -20,7 +20,7 @@ inline float max_component(float3 v) { return fmax(v.x, fmax(v.y, v.z)); }
 /* True when the memo holds the ray from sp along wi, bit for bit: the estimator traced the
  * continuation already (its BSDF or cosine direction from the same numbers). */
 inline bool memo_holds(const TraceMemo* memo, const SurfacePoint* sp, float3 wi) {
-    float3 o = offset_ray_origin(sp->p, sp->n);
+    float3 o = spawn_origin(sp);
     return memo->valid && all(as_uint3(memo->origin) == as_uint3(o)) &&
            all(as_uint3(memo->wi) == as_uint3(wi));
 }
@@ -44,7 +44,7 @@ inline float3 path_radiance(const SceneView* scene, const Ray* r, SampleStream* 
                             uint max_depth, uint rr_depth, PathRecord* record) {
     TraceMemo* memo = scene->memo; /* may be 0 (direct lighting keeps none) */
     record->rays += 1u;
-    Hit hit = bvh_closest_hit(scene->nodes, scene->packets, r, MAXFLOAT);
+    Hit hit = bvh_closest_hit(scene->nodes, scene->packets, r, MAXFLOAT, MCRT_NO_HIT);
 #if defined(ESTIMATOR_USES_SKY)
     if (hit.lane == MCRT_NO_HIT) return scene->env.sky;
 #else

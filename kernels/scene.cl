@@ -28,11 +28,13 @@ typedef struct {
 
 /* A surface point seen along a ray. */
 typedef struct {
-    float3 p;   /* from barycentrics, not from o + t·d (Wächter & Binder 2019) */
-    float3 n;   /* unit geometric normal, flipped toward the incoming ray */
+    float3 p;       /* from barycentrics, not from o + t·d (PBRT 4th ed. sec. 6.8.5) */
+    float3 p_error; /* per-component bound on p's distance from its triangle (geometry.cl) */
+    float3 n;       /* unit geometric normal, flipped toward the incoming ray */
     float3 wo;  /* unit, toward where the ray came from */
     bool front; /* the ray arrived on the counter-clockwise (front) side */
     uint light; /* index of its Light plus one; 0 when it is not a light */
+    uint lane;  /* its triangle's packet lane, which rays leaving it skip; MCRT_NO_HIT: none */
     Material material;
 } SurfacePoint;
 
@@ -41,11 +43,34 @@ inline SurfacePoint surface_point(const SceneView* scene, const Ray* r, const Hi
     uint lane = hit->lane % MCRT_PACKET_WIDTH;
     global const float* v =
         (global const float*)scene->packets[hit->lane / MCRT_PACKET_WIDTH].v + lane;
-    float3 p0 = (float3)(v[0], v[4], v[8]);
-    float3 e1 = (float3)(v[12], v[16], v[20]) - p0, e2 = (float3)(v[24], v[28], v[32]) - p0;
+    float3 p0 = (float3)(v[0], v[4], v[8]), p1 = (float3)(v[12], v[16], v[20]),
+           p2 = (float3)(v[24], v[28], v[32]);
+    float3 e1 = p1 - p0, e2 = p2 - p0;
     TriangleInfo info = scene->triangle_info[hit->lane];
     SurfacePoint sp;
-    sp.p = p0 + hit->b1 * e1 + hit->b2 * e2;
+    float3 b1_e1 = hit->b1 * e1, b2_e2 = hit->b2 * e2;
+    sp.p = p0 + b1_e1 + b2_e2;
+    sp.p_error = interpolation_error(p0, b1_e1, b2_e2);
+#ifdef MCRT_HAVE_FP64
+    /* Where the ray meets the triangle's plane, in double, rounded to float toward the ray's
+     * origin: within an ulp of the exact point along the plane too, where the barycentric form
+     * is off by the vertices' rounding (6e-5 m on a 2 km floor), and on the ray's side of any
+     * surface that the ulp straddles, as the exact point is (it is the closest hit). Rounded
+     * to nearest, a floor point a fraction of an ulp from a wall's base would land on the wall
+     * and see past it. The double arithmetic's own error (a few 2^-53 of the magnitudes it
+     * sums) is added to the bound. */
+    double3 o = convert_double3(r->org), dir = convert_double3(r->dir);
+    double3 d0 = convert_double3(p0);
+    double3 nd = cross(convert_double3(p1) - d0, convert_double3(p2) - d0);
+    double t = dot(d0 - o, nd) / dot(dir, nd);
+    if (isfinite(t) && t > 0.0) {
+        double3 td = t * dir, pd = o + td;
+        sp.p = select(convert_float3_rtp(pd), convert_float3_rtn(pd), r->dir > (float3)(0.0f));
+        sp.p_error = 0x1.0p-23f * fabs(sp.p) +
+                     0x1.0p-48f * (fabs(convert_float3(o)) + fabs(convert_float3(td)) + fabs(p0));
+    }
+#endif
+    sp.lane = hit->lane;
     float3 ng = normalize(cross(e1, e2));
     sp.front = dot(ng, r->dir) < 0.0f;
     sp.n = sp.front ? ng : -ng;
@@ -76,22 +101,32 @@ inline float3 environment_radiance(const SceneView* scene) {
     return scene->env.sky_pmf > 0.0f ? scene->env.sky : (float3)(0.0f);
 }
 
-/* True if nothing blocks the segment between the offset origins of a and b; na and nb are the
- * geometric normals on the sides the segment leaves a and reaches b. */
-inline bool visible(const SceneView* scene, float3 a, float3 na, float3 b, float3 nb) {
-    float3 o = offset_ray_origin(a, na);
-    float3 target = offset_ray_origin(b, nb);
-    Ray shadow = make_ray(o, target - o);
-    return !bvh_any_hit(scene->nodes, scene->packets, &shadow, 1.0f);
+/* The origin of rays leaving sp on the side of its normal (geometry.cl). */
+inline float3 spawn_origin(const SurfacePoint* sp) {
+    return offset_ray_origin(sp->p, sp->p_error, sp->n);
 }
 
-/* The first surface along direction wi (unit, world) from sp, offset off its surface; false
+/* True if nothing blocks the segment from sp to the point y, whose per-component error bound
+ * is y_error (zero for a point known exactly) and n_y the unit geometric normal of y's surface
+ * on the side the segment reaches. Both ends are moved off their surfaces by their bounds
+ * (PBRT 4th ed. sec. 6.8.6, SpawnRayTo), sp's triangle is skipped, and a hit counts only where
+ * rounding cannot have put it at either end (bvh_any_hit). Not counted in the rays. */
+inline bool visible(const SceneView* scene, const SurfacePoint* sp, float3 y, float3 y_error,
+                    float3 n_y) {
+    float3 o = spawn_origin(sp);
+    float3 target = offset_ray_origin(y, y_error, n_y);
+    Ray shadow = make_ray(o, target - o);
+    return !bvh_any_hit(scene->nodes, scene->packets, &shadow, 1.0f, sp->lane);
+}
+
+/* The first surface along direction wi (unit, world) from sp, leaving its surface as visible
+ * does (its triangle skipped, the origin off its plane by its error bound); false
  * when the ray leaves the scene. Counts the ray in *rays. */
 inline bool trace_from(const SceneView* scene, const SurfacePoint* sp, float3 wi, uint* rays,
                        SurfacePoint* seen) {
     *rays += 1u;
-    Ray r = make_ray(offset_ray_origin(sp->p, sp->n), wi);
-    Hit hit = bvh_closest_hit(scene->nodes, scene->packets, &r, MAXFLOAT);
+    Ray r = make_ray(spawn_origin(sp), wi);
+    Hit hit = bvh_closest_hit(scene->nodes, scene->packets, &r, MAXFLOAT, sp->lane);
     bool found = hit.lane != MCRT_NO_HIT;
     if (found) *seen = surface_point(scene, &r, &hit);
     if (scene->memo) {
@@ -109,8 +144,8 @@ inline bool trace_from(const SceneView* scene, const SurfacePoint* sp, float3 wi
 inline bool escapes(const SceneView* scene, const SurfacePoint* sp, float3 wi, float t_max,
                     uint* rays) {
     *rays += 1u;
-    Ray r = make_ray(offset_ray_origin(sp->p, sp->n), wi);
-    return !bvh_any_hit(scene->nodes, scene->packets, &r, t_max);
+    Ray r = make_ray(spawn_origin(sp), wi);
+    return !bvh_any_hit(scene->nodes, scene->packets, &r, t_max, sp->lane);
 }
 
 #endif

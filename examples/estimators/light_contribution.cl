@@ -102,6 +102,6 @@ float3 estimate(const SceneView* scene, const SurfacePoint* sp, const SampleStre
 
     *rays += 1u;
     float3 n_toward_x = dot(n_light, wi) < 0.0f ? n_light : -n_light;
-    if (!visible(scene, sp->p, sp->n, lp.p, n_toward_x)) return (float3)(0.0f);
+    if (!visible(scene, sp, lp.p, lp.p_error, n_toward_x)) return (float3)(0.0f);
     return bsdf_eval(sp, wi) * light.Le.xyz * (cos_x * cos_y / (d2 * lp.pdf_a * pmf));
 }
