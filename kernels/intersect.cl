@@ -93,13 +93,18 @@ inline __attribute__((always_inline)) int4 intersect_packet(const PacketRay* q,
     float4 t = t_scaled * inv_det;
 
     /* δt, PBRT 4th ed. sec. 6.8.7: the errors of the translated and sheared coordinates (δx, δy,
-     * δz), of the edge functions (δe) and of t_scaled, over |det|. */
+     * δz), of the edge functions (δe) and of t_scaled, over |det|. The shear's error in x and y
+     * is bounded by the translated z before its scaling by 1/d_z (|S_x|, |S_y| ≤ 1), in length as
+     * x and y are; pbrt takes the scaled z there, as large as 1/|d| times too large for a ray
+     * whose direction is not unit (a shadow ray's spans its segment): every hit of a short
+     * segment would fall within its own "error". */
     float4 max_zt = max(fabs(az), max(fabs(bz), fabs(cz)));
+    float4 max_z = max(fabs(a_z), max(fabs(b_z), fabs(c_z)));
     float4 max_xt = max(fabs(ax), max(fabs(bx), fabs(cx)));
     float4 max_yt = max(fabs(ay), max(fabs(by), fabs(cy)));
     float4 delta_z = MCRT_GAMMA(3) * max_zt;
-    float4 delta_x = MCRT_GAMMA(5) * (max_xt + max_zt);
-    float4 delta_y = MCRT_GAMMA(5) * (max_yt + max_zt);
+    float4 delta_x = MCRT_GAMMA(5) * (max_xt + max_z);
+    float4 delta_y = MCRT_GAMMA(5) * (max_yt + max_z);
     float4 delta_e = 2.0f * (MCRT_GAMMA(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
     float4 max_e = max(fabs(u), max(fabs(v_), fabs(w_)));
     float4 delta_t = 3.0f *
