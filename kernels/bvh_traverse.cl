@@ -86,12 +86,13 @@ inline int4 skipped_lanes(const SkipLane* s, uint packet) {
     return packet == s->packet ? s->lanes : (int4)(0);
 }
 
-/* Closest hit with t in (δt, t_max) (intersect.cl), never on the triangle at packet lane `skip`
+/* Closest hit with t in (t_min, t_max), never on the triangle at packet lane `skip`
  * (MCRT_NO_HIT: none). Children are visited nearest first; the others wait on the
  * stack with their entry distances and are skipped once a nearer hit is found. An empty scene's
  * root has only empty slots, so no ray enters it. */
-inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePacket* packets,
-                           const Ray* r, float t_max, uint skip) {
+inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
+    global const Bvh4Node* nodes, global const TrianglePacket* packets, const Ray* r, float t_min,
+    float t_max, uint skip) {
     Hit hit;
     hit.t = t_max;
     hit.b1 = hit.b2 = 0.0f;
@@ -148,8 +149,8 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePa
             for (uint k = 0; k < count; k += MCRT_PACKET_WIDTH, ++pk) {
                 float4 t4 = (float4)(0.0f), b1 = (float4)(0.0f), b2 = (float4)(0.0f);
                 uint packet = ref + k / MCRT_PACKET_WIDTH;
-                int4 lanes = intersect_packet(&q, pk, hit.t, skipped_lanes(&s, packet), false,
-                                              &t4, &b1, &b2);
+                int4 lanes = intersect_packet(&q, pk, t_min, hit.t, skipped_lanes(&s, packet),
+                                              false, &t4, &b1, &b2);
                 /* The nearest hit lane, the first of equals (leaf order, as one triangle at a time
                  * would take them), by compares instead of a loop over private arrays; taken by
                  * selects, not a branch on whether any lane hit (which mispredicted). A lane hits
@@ -176,6 +177,24 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePa
         }
         ref = stack_ref[sp];
         count = stack_count[sp];
+    }
+}
+
+/* Closest hit with t in (δt, t_max), δt the hit's own rounding bound (intersect.cl), never on
+ * the triangle at packet lane `skip` (MCRT_NO_HIT: none). Only the winner's δt is computed: a
+ * winner within it (a coplanar neighbour of the surface a ray leaves, hit at t ≈ 0 by rounding)
+ * is passed over by traversing again beyond its δt. */
+inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePacket* packets,
+                           const Ray* r, float t_max, uint skip) {
+    float t_min = 0.0f;
+    for (;;) {
+        Hit hit = bvh_closest_hit_beyond(nodes, packets, r, t_min, t_max, skip);
+        if (hit.lane == MCRT_NO_HIT) return hit;
+        PacketRay q = make_packet_ray(r);
+        float bound = lane_t_rounding_bound(&q, packets + hit.lane / MCRT_PACKET_WIDTH,
+                                            hit.lane % MCRT_PACKET_WIDTH);
+        if (hit.t > bound) return hit;
+        t_min = bound; /* strictly larger each time: the loop ends */
     }
 }
 
@@ -210,7 +229,7 @@ inline bool bvh_any_hit(global const Bvh4Node* nodes, global const TrianglePacke
             for (uint k = 0; k < count; k += MCRT_PACKET_WIDTH, ++pk) {
                 float4 t4, b1, b2;
                 int4 skipped = skipped_lanes(&sk, child + k / MCRT_PACKET_WIDTH);
-                if (any(intersect_packet(&q, pk, t_max, skipped, true, &t4, &b1, &b2)))
+                if (any(intersect_packet(&q, pk, 0.0f, t_max, skipped, true, &t4, &b1, &b2)))
                     return true;
             }
         }

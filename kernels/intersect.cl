@@ -37,24 +37,42 @@ inline PacketRay make_packet_ray(const Ray* r) {
     return q;
 }
 
+/* Bound δt on the rounding error of the distance t that the test below computes, for lanes
+ * that hit (PBRT 4th ed. sec. 6.8.7, "Avoiding intersections behind ray origins", in a looser
+ * closed form): from the magnitudes of the translated, permuted and sheared vertices — max_zt of
+ * z scaled by 1/d_z (in t), max_z of z before it, max_xt and max_yt of x and y (in length) — and
+ * 1/det. pbrt's bound is 3(γ3 e z + δe z + δz e)/|det| with e = max |edge function| ≤ |det| on
+ * a hit lane, δz = γ3 z, δe = 2(γ2 x y + δy x + δx y), δx = γ5(x + Z), δy = γ5(y + Z), so
+ * δt ≤ z (6γ3 + 6((γ2 + 2γ5) x y + γ5 Z (x + y))/|det|), which drops e and a few operations.
+ * pbrt puts the scaled z in δx and δy; the shear's error is bounded by the unscaled Z
+ * (|S_x|, |S_y| ≤ 1), and the scaled one is 1/|d| times too large for a ray whose direction is
+ * not unit (a shadow ray's spans its segment): every hit of a short segment would fall within
+ * its own "error". */
+inline float4 t_rounding_bound(float4 max_zt, float4 max_z, float4 max_xt, float4 max_yt,
+                               float4 inv_det) {
+    float4 half_delta_e = (MCRT_GAMMA(2) + 2.0f * MCRT_GAMMA(5)) * max_xt * max_yt +
+                          MCRT_GAMMA(5) * max_z * (max_xt + max_yt);
+    return max_zt * (6.0f * MCRT_GAMMA(3) + 6.0f * half_delta_e * fabs(inv_det));
+}
+
 /* The watertight test on the four triangles of a packet at once, each lane doing exactly the
  * operations of the scalar test of Woop et al. in the same order (so a lane's answer does not
  * depend on its packet): translate to the ray origin, permute so that z is the dominant axis,
  * shear (sec. 3); scaled barycentrics as 2D edge functions, recomputed in double when one is an
  * exact zero, which may be a rounding artefact on a shared edge; the scaled hit distance compared
- * before dividing. A hit counts only where its distance is beyond its own rounding error δt
- * (PBRT 4th ed., sec. 6.8.7, "Avoiding intersections behind ray origins"): t > δt, so that a ray
- * leaving a surface cannot hit that surface's plane again however large its triangles; and with
- * `conservative_far` (occlusion queries) also t + δt < t_max, so that a shadow ray aimed at a
- * point on a light is not stopped by the light's own plane. Lanes set in `skip` (the triangle a
- * ray leaves: a flat triangle cannot be hit again by a ray leaving it) never hit. Returns a lane
- * mask (-1 where a used lane is hit with t in (δt, t_max)) and the lanes' t and barycentrics
- * b1, b2 of vertices 1 and 2. Forced inline: PoCL's inliner prices it just over its threshold
- * (565 against 562) and called it, which cost the closest hit about 10% (docs/BENCHMARKS.md). */
+ * before dividing. Returns a lane mask (-1 where a used lane not set in `skip` is hit with t in
+ * (t_min, t_max)) and the lanes' t and barycentrics b1, b2 of vertices 1 and 2. With `bounded`
+ * (occlusion queries) a hit must also lie beyond its own rounding bound δt at both ends,
+ * t in (δt, t_max − δt): a ray leaving a surface cannot then hit that surface's plane again
+ * however large its triangles, nor a shadow ray the light's plane it ends at. The closest hit
+ * checks its one winner instead (bvh_closest_hit). Lanes in `skip` are the triangle a ray
+ * leaves: a flat triangle cannot be hit again by a ray leaving it. Forced inline: PoCL's inliner
+ * prices it just over its threshold (565 against 562) and called it, which cost the closest hit
+ * about 10% (docs/BENCHMARKS.md). */
 inline __attribute__((always_inline)) int4 intersect_packet(const PacketRay* q,
                                                             global const TrianglePacket* pk,
-                                                            float t_max, int4 skip,
-                                                            bool conservative_far, float4* t_hit,
+                                                            float t_min, float t_max, int4 skip,
+                                                            bool bounded, float4* t_hit,
                                                             float4* b1, float4* b2) {
     global const float4* v = pk->v;
     float4 a_x = v[q->kx] - q->org_x, a_y = v[q->ky] - q->org_y, a_z = v[q->kz] - q->org_z;
@@ -91,31 +109,38 @@ inline __attribute__((always_inline)) int4 intersect_packet(const PacketRay* q,
     float4 t_scaled = u * az + v_ * bz + w_ * cz;
     float4 inv_det = 1.0f / det;
     float4 t = t_scaled * inv_det;
-
-    /* δt, PBRT 4th ed. sec. 6.8.7: the errors of the translated and sheared coordinates (δx, δy,
-     * δz), of the edge functions (δe) and of t_scaled, over |det|. The shear's error in x and y
-     * is bounded by the translated z before its scaling by 1/d_z (|S_x|, |S_y| ≤ 1), in length as
-     * x and y are; pbrt takes the scaled z there, as large as 1/|d| times too large for a ray
-     * whose direction is not unit (a shadow ray's spans its segment): every hit of a short
-     * segment would fall within its own "error". */
-    float4 max_zt = max(fabs(az), max(fabs(bz), fabs(cz)));
-    float4 max_z = max(fabs(a_z), max(fabs(b_z), fabs(c_z)));
-    float4 max_xt = max(fabs(ax), max(fabs(bx), fabs(cx)));
-    float4 max_yt = max(fabs(ay), max(fabs(by), fabs(cy)));
-    float4 delta_z = MCRT_GAMMA(3) * max_zt;
-    float4 delta_x = MCRT_GAMMA(5) * (max_xt + max_z);
-    float4 delta_y = MCRT_GAMMA(5) * (max_yt + max_z);
-    float4 delta_e = 2.0f * (MCRT_GAMMA(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-    float4 max_e = max(fabs(u), max(fabs(v_), fabs(w_)));
-    float4 delta_t = 3.0f *
-                     (MCRT_GAMMA(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) *
-                     fabs(inv_det);
-    float4 t_end = conservative_far ? (float4)(t_max) - delta_t : (float4)(t_max);
-    hit &= (t > delta_t) & (t < t_end);
     *t_hit = t;
     *b1 = v_ * inv_det;
     *b2 = w_ * inv_det;
-    return hit;
+    hit &= (t > (float4)(t_min)) & (t < (float4)(t_max));
+    if (!bounded || !any(hit)) return hit;
+
+    float4 delta_t = t_rounding_bound(max(fabs(az), max(fabs(bz), fabs(cz))),
+                                      max(fabs(a_z), max(fabs(b_z), fabs(c_z))),
+                                      max(fabs(ax), max(fabs(bx), fabs(cx))),
+                                      max(fabs(ay), max(fabs(by), fabs(cy))), inv_det);
+    return hit & (t > delta_t) & (t < (float4)(t_max) - delta_t);
+}
+
+/* δt of lane `lane` of a packet for the ray (t_rounding_bound), with the test's own arithmetic. */
+inline float lane_t_rounding_bound(const PacketRay* q, global const TrianglePacket* pk,
+                                   uint lane) {
+    global const float4* v = pk->v;
+    float4 a_x = v[q->kx] - q->org_x, a_y = v[q->ky] - q->org_y, a_z = v[q->kz] - q->org_z;
+    float4 b_x = v[3u + q->kx] - q->org_x, b_y = v[3u + q->ky] - q->org_y,
+           b_z = v[3u + q->kz] - q->org_z;
+    float4 c_x = v[6u + q->kx] - q->org_x, c_y = v[6u + q->ky] - q->org_y,
+           c_z = v[6u + q->kz] - q->org_z;
+    float4 ax = a_x - q->shear_x * a_z, ay = a_y - q->shear_y * a_z;
+    float4 bx = b_x - q->shear_x * b_z, by = b_y - q->shear_y * b_z;
+    float4 cx = c_x - q->shear_x * c_z, cy = c_y - q->shear_y * c_z;
+    float4 det = (cx * by - cy * bx) + (ax * cy - ay * cx) + (bx * ay - by * ax);
+    float4 az = q->shear_z * a_z, bz = q->shear_z * b_z, cz = q->shear_z * c_z;
+    float4 d = t_rounding_bound(max(fabs(az), max(fabs(bz), fabs(cz))),
+                                max(fabs(a_z), max(fabs(b_z), fabs(c_z))),
+                                max(fabs(ax), max(fabs(bx), fabs(cx))),
+                                max(fabs(ay), max(fabs(by), fabs(cy))), 1.0f / det);
+    return lane == 0u ? d.x : lane == 1u ? d.y : lane == 2u ? d.z : d.w;
 }
 
 /* Contraction is harmless, and faster, in the rest of the program. */
