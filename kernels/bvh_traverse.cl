@@ -180,16 +180,18 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
     }
 }
 
-/* Closest hit with t in (δt, t_max), δt the hit's own rounding bound (intersect.cl), never on
- * the triangle at packet lane `skip` (MCRT_NO_HIT: none). Only the winner's δt is computed: a
- * winner within it (a coplanar neighbour of the surface a ray leaves, hit at t ≈ 0 by rounding)
- * is passed over by traversing again beyond its δt. */
+/* Closest hit with t in (0, t_max), never on the triangle at packet lane `skip`; for a ray that
+ * leaves a surface (skip is its triangle, not MCRT_NO_HIT) also beyond δt, the hit's own
+ * rounding bound (intersect.cl). Only the winner's δt is computed: a winner within it (a
+ * coplanar neighbour of the surface the ray leaves, hit at t ≈ 0 by rounding) is passed over by
+ * traversing again beyond its δt. A camera ray starts on no surface and needs no bound (it cost
+ * the bench's primary rays 12% on veach-mis). */
 inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                            const Ray* r, float t_max, uint skip) {
     float t_min = 0.0f;
     for (;;) {
         Hit hit = bvh_closest_hit_beyond(nodes, packets, r, t_min, t_max, skip);
-        if (hit.lane == MCRT_NO_HIT) return hit;
+        if (hit.lane == MCRT_NO_HIT || skip == MCRT_NO_HIT) return hit;
         PacketRay q = make_packet_ray(r);
         float bound = lane_t_rounding_bound(&q, packets + hit.lane / MCRT_PACKET_WIDTH,
                                             hit.lane % MCRT_PACKET_WIDTH);
