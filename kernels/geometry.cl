@@ -68,9 +68,15 @@ inline float3 offset_ray_origin(float3 p, float3 p_error, float3 n) {
     float d = dot(fabs(n), p_error);
     float3 offset = d * n;
     float3 po = p + offset;
-    po = select(po, nextafter(po, (float3)(INFINITY)), offset > (float3)(0.0f));
-    po = select(po, nextafter(po, (float3)(-INFINITY)), offset < (float3)(0.0f));
-    return po;
+    /* One float further: the bits of a nonzero float step away from zero by ±1; a zero steps
+     * to the least denormal of the offset's sign. */
+    int3 bits = as_int3(po);
+    int3 away = (offset > (float3)(0.0f)) == (po >= (float3)(0.0f)); /* the offset leads away from 0 */
+    int3 step = select((int3)(-1), (int3)(1), away);
+    float3 moved = as_float3(bits + step);
+    float3 from_zero = copysign((float3)(0x1.0p-149f), offset);
+    moved = select(moved, from_zero, po == (float3)(0.0f));
+    return select(po, moved, offset != (float3)(0.0f));
 }
 
 #endif
