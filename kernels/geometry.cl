@@ -55,6 +55,16 @@ inline float3 interpolation_error(float3 p0, float3 b1_e1, float3 b2_e2) {
     return MCRT_GAMMA(5) * (fabs(p0) + fabs(b1_e1) + fabs(b2_e2));
 }
 
+/* Each component of x moved to the next float in the direction of the sign of `toward`'s, and
+ * left where that is 0: the bits of a nonzero float step away from zero by +1 or toward it by
+ * −1; a zero steps to the least denormal of that sign (nextafter for finite x, by the bits). */
+inline float3 float_step(float3 x, float3 toward) {
+    int3 away = (toward > (float3)(0.0f)) == (x >= (float3)(0.0f));
+    float3 moved = as_float3(as_int3(x) + select((int3)(-1), (int3)(1), away));
+    moved = select(moved, copysign((float3)(0x1.0p-149f), toward), x == (float3)(0.0f));
+    return select(x, moved, toward != (float3)(0.0f));
+}
+
 /* The origin of a ray leaving the point p (per-component error bound p_error) on the side of
  * n, its surface's unit geometric normal on that side: p moved along n by d = |n|·p_error,
  * which puts every point p_error allows on that side of the surface's plane, then each moved
@@ -68,15 +78,7 @@ inline float3 offset_ray_origin(float3 p, float3 p_error, float3 n) {
     float d = dot(fabs(n), p_error);
     float3 offset = d * n;
     float3 po = p + offset;
-    /* One float further: the bits of a nonzero float step away from zero by ±1; a zero steps
-     * to the least denormal of the offset's sign. */
-    int3 bits = as_int3(po);
-    int3 away = (offset > (float3)(0.0f)) == (po >= (float3)(0.0f)); /* the offset leads away from 0 */
-    int3 step = select((int3)(-1), (int3)(1), away);
-    float3 moved = as_float3(bits + step);
-    float3 from_zero = copysign((float3)(0x1.0p-149f), offset);
-    moved = select(moved, from_zero, po == (float3)(0.0f));
-    return select(po, moved, offset != (float3)(0.0f));
+    return float_step(po, offset);
 }
 
 #endif

@@ -64,10 +64,15 @@ inline SurfacePoint surface_point(const SceneView* scene, const Ray* r, const Hi
     double3 nd = cross(convert_double3(p1) - d0, convert_double3(p2) - d0);
     double t = dot(d0 - o, nd) / dot(dir, nd);
     if (isfinite(t) && t > 0.0) {
-        double3 td = t * dir, pd = o + td;
-        sp.p = select(convert_float3_rtp(pd), convert_float3_rtn(pd), r->dir > (float3)(0.0f));
+        double3 pd = o + t * dir;
+        /* Rounded to nearest, then one float back toward the origin where that went past pd
+         * (cheaper than a directed conversion, which PoCL emulates). */
+        float3 pf = convert_float3(pd);
+        long3 past = (convert_double3(pf) - pd) * dir > (double3)(0.0);
+        sp.p = select(pf, float_step(pf, -r->dir), convert_int3(past));
+        /* |o + t·d| ≤ |o| + |t·d| ≤ 2|o| + |p|. */
         sp.p_error = 0x1.0p-23f * fabs(sp.p) +
-                     0x1.0p-48f * (fabs(convert_float3(o)) + fabs(convert_float3(td)) + fabs(p0));
+                     0x1.0p-47f * (fabs(r->org) + fabs(sp.p) + fabs(p0));
     }
 #endif
     sp.lane = hit->lane;

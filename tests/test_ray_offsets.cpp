@@ -348,3 +348,50 @@ TEST_CASE("no light leaks into a box resting on a large floor, and none is lost 
                              {strategies.begin(), strategies.end() - 1});
     }
 }
+
+TEST_CASE("ambient occlusion next to a wall is exact on floors up to 100 km and far from the origin",
+          "[offsets][analytic]") {
+    // The ambient estimators' scene (a wall x = 0 of height 1 and width 3 on a floor, under a
+    // uniform sky) on large floors and moved away from the origin: at a floor point the
+    // unoccluded share of (1/π)∫cosθ dω is 1 − F, F the wall's form factor.
+    DeviceContext device = first_device();
+    const glm::dvec3 albedo(0.7, 0.6, 0.5), sky(1.0, 2.0, 0.5);
+    struct Case {
+        double floor_width;
+        Placement place;
+    };
+    for (const Case& k : {Case{6.0, {}}, Case{2e3, {}}, Case{2e5, {}},
+                          Case{2e3, {1.0, glm::dvec3(1e4, 0.5e4, -0.7e4)}},
+                          Case{2e3, {1e3, glm::dvec3(0.0)}}}) {
+        const Placement& place = k.place;
+        auto P = [&](double x, double y, double z) { return glm::vec3(place({x, y, z})); };
+        Scene scene;
+        const double h = k.floor_width / 2;
+        add_quad(scene, P(-h, 0, -h), P(-h, 0, h), P(h, 0, h), P(h, 0, -h),
+                 add_material(scene, glm::vec3(albedo)));
+        std::vector<glm::dvec3> wall = {place({0, 0, -1.5}), place({0, 1, -1.5}),
+                                        place({0, 1, 1.5}), place({0, 0, 1.5})};
+        add_quad(scene, glm::vec3(wall[0]), glm::vec3(wall[1]), glm::vec3(wall[2]),
+                 glm::vec3(wall[3]), add_material(scene, glm::vec3(0.3f)));
+        // From 0.5 m beside the wall, down onto the floor up to its base.
+        Camera camera = camera_at(place({0.5, 1.0, 0}), place({0.5, 0, 0}), 2 * std::atan(0.5));
+        const double floor_y = place({0, 0, 0}).y;
+        ExactImage exact = exact_image(camera, [&](glm::dvec3 eye, glm::dvec3 d) {
+            glm::dvec3 p = eye + ((floor_y - eye.y) / d.y) * d;
+            p.y = floor_y;
+            const double form_factor = lambert_irradiance(wall, p, {0, 1, 0}, 1.0) / M_PI;
+            return albedo * sky * (1.0 - form_factor);
+        });
+        RenderSettings settings;
+        settings.width = settings.height = kSize;
+        settings.sky = glm::vec3(sky);
+        GpuSceneData data = gpu_scene_for(scene, camera, settings);
+        for (const char* estimator : {"ambient-uniform", "ambient-cosine"}) {
+            settings.estimator = estimator;
+            settings.spp = 32;
+            check_bands(device, data, settings, exact,
+                        "floor " + std::to_string(k.floor_width) + " m, " + place.label() + ", " +
+                            estimator);
+        }
+    }
+}
