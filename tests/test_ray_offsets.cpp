@@ -349,7 +349,7 @@ TEST_CASE("no light leaks into a box resting on a large floor, and none is lost 
     }
 }
 
-TEST_CASE("ambient occlusion next to a wall is exact on floors up to 100 km and far from the origin",
+TEST_CASE("ambient occlusion next to a wall is exact on floors up to 200 km and far from the origin",
           "[offsets][analytic]") {
     // The ambient estimators' scene (a wall x = 0 of height 1 and width 3 on a floor, under a
     // uniform sky) on large floors and moved away from the origin: at a floor point the
