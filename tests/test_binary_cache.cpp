@@ -159,6 +159,26 @@ TEST_CASE("the key covers device, driver, source, options; its file name is hex"
     }
 }
 
+TEST_CASE("the key covers the vendor compiler's settings in the environment", "[cache]") {
+    // Intel's CPU runtime builds other code under CL_CONFIG_USE_VECTORIZER=False: a binary
+    // cached under one setting must not be read under the other.
+    DeviceInfo info;
+    info.platform_name = "Intel(R) OpenCL";
+    ScopedEnv env;
+    env.unset("CL_CONFIG_USE_VECTORIZER");
+    BinaryCacheKey plain = binary_cache_key(info, kSource, kOptions);
+    env.set("CL_CONFIG_USE_VECTORIZER", "False");
+    BinaryCacheKey off = binary_cache_key(info, kSource, kOptions);
+    CHECK(off != plain);
+    env.set("CL_CONFIG_USE_VECTORIZER", "True");
+    CHECK(binary_cache_key(info, kSource, kOptions) != off);
+    env.unset("CL_CONFIG_USE_VECTORIZER");
+    CHECK(binary_cache_key(info, kSource, kOptions) == plain);
+    // Other variables do not change it.
+    env.set("MCRT_UNRELATED_SETTING", "1");
+    CHECK(binary_cache_key(info, kSource, kOptions) == plain);
+}
+
 TEST_CASE("a first build writes one entry, the second is a hit", "[cache]") {
     DeviceContext device = first_device();
     TempCache cache;

@@ -1,6 +1,7 @@
 // Compiled program binaries on disk, keyed by device, driver, source and options.
 #include "cl/binary_cache.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -10,6 +11,8 @@
 #include <iterator>
 #include <system_error>
 #include <vector>
+
+#include <unistd.h>  // environ
 
 #include "cl/cl_error.h"
 #include "cl/program.h"
@@ -178,6 +181,20 @@ std::vector<unsigned char> program_binary(const cl::Program& program, const cl::
     return {};
 }
 
+// The environment's compiler settings of the OpenCL implementations whose binaries this cache
+// holds, sorted: Intel's CPU runtime reads CL_CONFIG_* (its vectoriser among them) when it builds
+// a program, so a binary built under one setting is not the binary of another. (PoCL's programs
+// do not come through this cache: it keeps its own.)
+std::string compiler_environment() {
+    std::vector<std::string> entries;
+    for (char** e = environ; e && *e; ++e)
+        if (std::strncmp(*e, "CL_CONFIG_", 10) == 0) entries.emplace_back(*e);
+    std::sort(entries.begin(), entries.end());
+    std::string joined;
+    for (const std::string& entry : entries) joined += entry + "\n";
+    return joined;
+}
+
 }  // namespace
 
 std::string BinaryCacheKey::hex() const {
@@ -197,6 +214,7 @@ BinaryCacheKey binary_cache_key(const DeviceInfo& device, const std::string& sou
     append_field(canonical, "driver_version", device.driver_version);
     append_field(canonical, "options", options);
     append_field(canonical, "source", source);
+    append_field(canonical, "compiler_environment", compiler_environment());
     const auto* bytes = reinterpret_cast<const unsigned char*>(canonical.data());
     return {fnv1a_64(bytes, canonical.size()),
             murmur64a(bytes, canonical.size(), 0x9e3779b97f4a7c15ull)};

@@ -40,8 +40,10 @@ struct BinaryCacheKey {
 };
 
 // Key of the binary of `source` built with `options` for the device: platform name, device
-// name, device version, driver version, source, options and kBinaryCacheFormatVersion, each
-// length-prefixed so no two different field lists give the same string.
+// name, device version, driver version, source, options, kBinaryCacheFormatVersion and the
+// vendor compiler's settings from the environment (Intel's CL_CONFIG_* variables, such as
+// CL_CONFIG_USE_VECTORIZER, change the code it generates), each length-prefixed so no two
+// different field lists give the same string.
 BinaryCacheKey binary_cache_key(const DeviceInfo& device, const std::string& source,
                                 const std::string& options);
 
