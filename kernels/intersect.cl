@@ -55,6 +55,38 @@ inline float4 t_rounding_bound(float4 max_zt, float4 max_z, float4 max_xt, float
     return max_zt * (6.0f * MCRT_GAMMA(3) + 6.0f * half_delta_e * fabs(inv_det));
 }
 
+/* A packet's vertices translated to the ray origin and permuted (z the dominant axis), with x
+ * and y sheared (Woop et al. 2013, sec. 3); z is not yet scaled by 1/d_z. */
+typedef struct {
+    float4 ax, ay, bx, by, cx, cy;
+    float4 a_z, b_z, c_z;
+} ShearedPacket;
+
+inline __attribute__((always_inline)) ShearedPacket shear_packet(const PacketRay* q,
+                                                                 global const TrianglePacket* pk) {
+    global const float4* v = pk->v;
+    ShearedPacket s;
+    s.a_z = v[q->kz] - q->org_z;
+    s.b_z = v[3u + q->kz] - q->org_z;
+    s.c_z = v[6u + q->kz] - q->org_z;
+    s.ax = (v[q->kx] - q->org_x) - q->shear_x * s.a_z;
+    s.ay = (v[q->ky] - q->org_y) - q->shear_y * s.a_z;
+    s.bx = (v[3u + q->kx] - q->org_x) - q->shear_x * s.b_z;
+    s.by = (v[3u + q->ky] - q->org_y) - q->shear_y * s.b_z;
+    s.cx = (v[6u + q->kx] - q->org_x) - q->shear_x * s.c_z;
+    s.cy = (v[6u + q->ky] - q->org_y) - q->shear_y * s.c_z;
+    return s;
+}
+
+/* t_rounding_bound of the four lanes of a sheared packet, az..cz its z scaled by 1/d_z. */
+inline float4 packet_t_rounding_bound(const ShearedPacket* s, float4 az, float4 bz, float4 cz,
+                                      float4 inv_det) {
+    return t_rounding_bound(max(fabs(az), max(fabs(bz), fabs(cz))),
+                            max(fabs(s->a_z), max(fabs(s->b_z), fabs(s->c_z))),
+                            max(fabs(s->ax), max(fabs(s->bx), fabs(s->cx))),
+                            max(fabs(s->ay), max(fabs(s->by), fabs(s->cy))), inv_det);
+}
+
 /* The watertight test on the four triangles of a packet at once, each lane doing exactly the
  * operations of the scalar test of Woop et al. in the same order (so a lane's answer does not
  * depend on its packet): translate to the ray origin, permute so that z is the dominant axis,
@@ -74,15 +106,8 @@ inline __attribute__((always_inline)) int4 intersect_packet(const PacketRay* q,
                                                             float t_min, float t_max, int4 skip,
                                                             bool bounded, float4* t_hit,
                                                             float4* b1, float4* b2) {
-    global const float4* v = pk->v;
-    float4 a_x = v[q->kx] - q->org_x, a_y = v[q->ky] - q->org_y, a_z = v[q->kz] - q->org_z;
-    float4 b_x = v[3u + q->kx] - q->org_x, b_y = v[3u + q->ky] - q->org_y,
-           b_z = v[3u + q->kz] - q->org_z;
-    float4 c_x = v[6u + q->kx] - q->org_x, c_y = v[6u + q->ky] - q->org_y,
-           c_z = v[6u + q->kz] - q->org_z;
-    float4 ax = a_x - q->shear_x * a_z, ay = a_y - q->shear_y * a_z;
-    float4 bx = b_x - q->shear_x * b_z, by = b_y - q->shear_y * b_z;
-    float4 cx = c_x - q->shear_x * c_z, cy = c_y - q->shear_y * c_z;
+    ShearedPacket s = shear_packet(q, pk);
+    float4 ax = s.ax, ay = s.ay, bx = s.bx, by = s.by, cx = s.cx, cy = s.cy;
 
     float4 u = cx * by - cy * bx;
     float4 w_ = bx * ay - by * ax;
@@ -105,7 +130,7 @@ inline __attribute__((always_inline)) int4 intersect_packet(const PacketRay* q,
     int4 hit = used & ~(negative & positive) & (det != 0.0f);
     if (!any(hit)) return hit;
 
-    float4 az = q->shear_z * a_z, bz = q->shear_z * b_z, cz = q->shear_z * c_z;
+    float4 az = q->shear_z * s.a_z, bz = q->shear_z * s.b_z, cz = q->shear_z * s.c_z;
     float4 t_scaled = u * az + v_ * bz + w_ * cz;
     float4 inv_det = 1.0f / det;
     float4 t = t_scaled * inv_det;
@@ -115,31 +140,18 @@ inline __attribute__((always_inline)) int4 intersect_packet(const PacketRay* q,
     hit &= (t > (float4)(t_min)) & (t < (float4)(t_max));
     if (!bounded || !any(hit)) return hit;
 
-    float4 delta_t = t_rounding_bound(max(fabs(az), max(fabs(bz), fabs(cz))),
-                                      max(fabs(a_z), max(fabs(b_z), fabs(c_z))),
-                                      max(fabs(ax), max(fabs(bx), fabs(cx))),
-                                      max(fabs(ay), max(fabs(by), fabs(cy))), inv_det);
+    float4 delta_t = packet_t_rounding_bound(&s, az, bz, cz, inv_det);
     return hit & (t > delta_t) & (t < (float4)(t_max) - delta_t);
 }
 
 /* δt of lane `lane` of a packet for the ray (t_rounding_bound), with the test's own arithmetic. */
 inline float lane_t_rounding_bound(const PacketRay* q, global const TrianglePacket* pk,
                                    uint lane) {
-    global const float4* v = pk->v;
-    float4 a_x = v[q->kx] - q->org_x, a_y = v[q->ky] - q->org_y, a_z = v[q->kz] - q->org_z;
-    float4 b_x = v[3u + q->kx] - q->org_x, b_y = v[3u + q->ky] - q->org_y,
-           b_z = v[3u + q->kz] - q->org_z;
-    float4 c_x = v[6u + q->kx] - q->org_x, c_y = v[6u + q->ky] - q->org_y,
-           c_z = v[6u + q->kz] - q->org_z;
-    float4 ax = a_x - q->shear_x * a_z, ay = a_y - q->shear_y * a_z;
-    float4 bx = b_x - q->shear_x * b_z, by = b_y - q->shear_y * b_z;
-    float4 cx = c_x - q->shear_x * c_z, cy = c_y - q->shear_y * c_z;
-    float4 det = (cx * by - cy * bx) + (ax * cy - ay * cx) + (bx * ay - by * ax);
-    float4 az = q->shear_z * a_z, bz = q->shear_z * b_z, cz = q->shear_z * c_z;
-    float4 d = t_rounding_bound(max(fabs(az), max(fabs(bz), fabs(cz))),
-                                max(fabs(a_z), max(fabs(b_z), fabs(c_z))),
-                                max(fabs(ax), max(fabs(bx), fabs(cx))),
-                                max(fabs(ay), max(fabs(by), fabs(cy))), 1.0f / det);
+    ShearedPacket s = shear_packet(q, pk);
+    float4 det = (s.cx * s.by - s.cy * s.bx) + (s.ax * s.cy - s.ay * s.cx) +
+                 (s.bx * s.ay - s.by * s.ax);
+    float4 d = packet_t_rounding_bound(&s, q->shear_z * s.a_z, q->shear_z * s.b_z,
+                                       q->shear_z * s.c_z, 1.0f / det);
     return lane == 0u ? d.x : lane == 1u ? d.y : lane == 2u ? d.z : d.w;
 }
 

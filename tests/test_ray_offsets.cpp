@@ -204,28 +204,28 @@ Camera view_grazing(const Placement& place) {
     return camera_at(place({0, 0.6, 0}), place({0, 0, 1.1}), M_PI / 3);
 }
 
+// The quad light over floors of each width, seen by `view`, every strategy against the exact image.
+void check_floors(std::initializer_list<double> widths, Camera (*view)(const Placement&),
+                  const std::string& view_name) {
+    DeviceContext device = first_device();
+    for (double width : widths) {
+        QuadOverFloor q(width, Placement{});
+        Camera camera = view(Placement{});
+        check_all_strategies(device, q.scene, camera, q.exact(camera),
+                             "floor " + std::to_string(width) + " m, " + view_name);
+    }
+}
+
 }  // namespace
 
 TEST_CASE("floors from 1 m to 100 km wide render the quad light's exact image",
           "[offsets][analytic]") {
-    DeviceContext device = first_device();
-    for (double width : {1.0, 10.0, 100.0, 1e3, 1e4, 1e5}) {
-        QuadOverFloor q(width, Placement{});
-        Camera camera = view_down(Placement{});
-        check_all_strategies(device, q.scene, camera, q.exact(camera),
-                             "floor " + std::to_string(width) + " m, view down");
-    }
+    check_floors({1.0, 10.0, 100.0, 1e3, 1e4, 1e5}, view_down, "view down");
 }
 
 TEST_CASE("floors seen at grazing angles render the quad light's exact image",
           "[offsets][analytic]") {
-    DeviceContext device = first_device();
-    for (double width : {20.0, 2e3, 2e5}) {
-        QuadOverFloor q(width, Placement{});
-        Camera camera = view_grazing(Placement{});
-        check_all_strategies(device, q.scene, camera, q.exact(camera),
-                             "floor " + std::to_string(width) + " m, grazing view");
-    }
+    check_floors({20.0, 2e3, 2e5}, view_grazing, "grazing view");
 }
 
 TEST_CASE("whole scenes scaled from 1e-3 to 1e3 and moved 1e4 m render the same exact image",
