@@ -11,6 +11,10 @@ std::string DeviceInfo::type_name() const {
     return "other";
 }
 
+bool DeviceInfo::ieee_basic_operations() const {
+    return (single_fp_config & CL_FP_DENORM) && (single_fp_config & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT);
+}
+
 template <cl_int Name, typename T>
 static T device_info(const cl::Device& device) {
     T value{};
@@ -29,6 +33,8 @@ std::vector<DeviceInfo> enumerate_devices(const std::function<void(const std::st
     for (size_t p = 0; p < platforms.size(); ++p) {
         std::string platform_name = "platform " + std::to_string(p);
         platforms[p].getInfo(CL_PLATFORM_NAME, &platform_name);
+        std::string platform_vendor;
+        platforms[p].getInfo(CL_PLATFORM_VENDOR, &platform_vendor);
         try {
             std::vector<cl::Device> platform_devices;
             status = platforms[p].getDevices(CL_DEVICE_TYPE_ALL, &platform_devices);
@@ -40,6 +46,7 @@ std::vector<DeviceInfo> enumerate_devices(const std::function<void(const std::st
                 info.platform = platforms[p];
                 info.device = d;
                 info.platform_name = platform_name;
+                info.platform_vendor = platform_vendor;
                 info.name = device_info<CL_DEVICE_NAME, std::string>(d);
                 info.vendor = device_info<CL_DEVICE_VENDOR, std::string>(d);
                 info.version = device_info<CL_DEVICE_VERSION, std::string>(d);
@@ -48,6 +55,9 @@ std::vector<DeviceInfo> enumerate_devices(const std::function<void(const std::st
                 info.global_memory = device_info<CL_DEVICE_GLOBAL_MEM_SIZE, cl_ulong>(d);
                 info.max_allocation = device_info<CL_DEVICE_MAX_MEM_ALLOC_SIZE, cl_ulong>(d);
                 info.compute_units = device_info<CL_DEVICE_MAX_COMPUTE_UNITS, cl_uint>(d);
+                info.single_fp_config =
+                    device_info<CL_DEVICE_SINGLE_FP_CONFIG, cl_device_fp_config>(d);
+                info.fp64 = device_info<CL_DEVICE_DOUBLE_FP_CONFIG, cl_device_fp_config>(d) != 0;
                 devices.push_back(std::move(info));
             }
         } catch (const ClError& e) {

@@ -93,8 +93,24 @@ cl::Program build_program(const cl::Context& context, const cl::Device& device,
     return program;
 }
 
+std::string device_program_options(const DeviceInfo& device) {
+    std::string options;
+    // Division and sqrt correctly rounded where the device offers it (OpenCL 1.2 sec. 5.6.4.2;
+    // without it they may be 2.5 and 3 ulp off): with contraction off in the sources
+    // (shared_types.h) and mcrt's own transcendentals (exact_math.cl), every operation the
+    // kernels use rounds as IEEE-754 says, and devices agree bit for bit.
+    if (device.single_fp_config & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT)
+        options += " -cl-fp32-correctly-rounded-divide-sqrt";
+    // Intel's CPU runtime: its vectoriser crashes on or miscompiles the render kernel
+    // (kernels/render.cl).
+    if (device.platform_name.find("Intel(R) OpenCL") != std::string::npos)
+        options += " -D MCRT_INTEL_NO_VECTORIZE";
+    return options;
+}
+
 cl::Program cached_program(const DeviceContext& device, const std::string& file,
-                           const std::string& options, const KernelReplacements& replacements) {
+                           const std::string& given_options, const KernelReplacements& replacements) {
+    const std::string options = given_options + device_program_options(device.info);
     // Keyed by the context handle: the cached program holds a reference to its context, so the
     // handle cannot be freed and reused while the entry exists.
     using Key = std::tuple<cl_context, cl_device_id, std::string, std::string>;

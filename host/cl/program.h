@@ -29,7 +29,11 @@ std::string kernel_source(const std::string& file, const KernelReplacements& rep
 cl::Program build_program(const cl::Context& context, const cl::Device& device,
                           const std::string& source, const std::string& options);
 
-// build_program(kernel_source(file), options) for the device, built once per process and kept:
+// The build options every program gets on this device, after its own: the arithmetic that makes
+// devices agree bit for bit, and workarounds for a vendor's compiler.
+std::string device_program_options(const DeviceInfo& device);
+
+// build_program(kernel_source(file), options + device_program_options) for the device, built once per process and kept:
 // every specialised variant (-D options) is compiled once, however many renders use it.
 // Thread-safe.
 cl::Program cached_program(const DeviceContext& device, const std::string& file,

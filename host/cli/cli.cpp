@@ -24,10 +24,14 @@ int run_devices() {
     std::vector<DeviceInfo> devices = enumerate_devices(print_warning);
     if (devices.empty()) throw RuntimeError(no_device_message());
     for (const DeviceInfo& d : devices) {
-        std::printf("%d: %s [%s] — %s, %s, %u compute units, %.1f GiB, driver %s\n", d.index,
-                    d.name.c_str(), d.type_name().c_str(), d.platform_name.c_str(),
-                    d.version.c_str(), d.compute_units, double(d.global_memory) / (1 << 30),
-                    d.driver_version.c_str());
+        std::printf("%d: %s [%s] — %s (%s), %s, %u compute units, %.1f GiB, driver %s%s\n",
+                    d.index, d.name.c_str(), d.type_name().c_str(), d.platform_name.c_str(),
+                    d.platform_vendor.c_str(), d.version.c_str(), d.compute_units,
+                    double(d.global_memory) / (1 << 30), d.driver_version.c_str(),
+                    d.ieee_basic_operations()
+                        ? ""
+                        : " (flushes denormals or rounds division or sqrt loosely: its images "
+                          "may differ from other devices' in the last bits)");
     }
     return 0;
 }

@@ -192,7 +192,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
     CLI::Option* camera = cmd->add_option("--camera", o.camera, "camera index in the scene")
                               ->check(CLI::Range(0, 1 << 30));
     add_camera_options(cmd, o.look, camera);
-    cmd->add_option("--device", o.devices, "device index, cpu, gpu or all (repeatable)");
+    cmd->add_option("--device", o.devices, "device index, cpu, gpu, all or a platform such as pocl or intel (repeatable)");
     cmd->add_option("--batch", o.batch, "samples per pixel per launch (0 chooses)")
         ->capture_default_str()
         ->check(CLI::Range(0u, 1u << 24));
