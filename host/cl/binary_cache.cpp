@@ -14,6 +14,7 @@
 
 #include <unistd.h>  // environ
 
+#include "cl/build_child.h"
 #include "cl/cl_error.h"
 #include "cl/program.h"
 #include "common/atomic_file.h"
@@ -149,6 +150,22 @@ std::vector<unsigned char> read_entry(const std::string& path, const BinaryCache
     return std::vector<unsigned char>(file.begin() + kHeaderBytes, file.end());
 }
 
+// The environment's compiler settings of the OpenCL implementations whose binaries this cache
+// holds, sorted: Intel's CPU runtime reads CL_CONFIG_* (its vectoriser among them) when it builds
+// a program, so a binary built under one setting is not the binary of another. (PoCL's programs
+// do not come through this cache: it keeps its own.)
+std::string compiler_environment() {
+    std::vector<std::string> entries;
+    for (char** e = environ; e && *e; ++e)
+        if (std::strncmp(*e, "CL_CONFIG_", 10) == 0) entries.emplace_back(*e);
+    std::sort(entries.begin(), entries.end());
+    std::string joined;
+    for (const std::string& entry : entries) joined += entry + "\n";
+    return joined;
+}
+
+}  // namespace
+
 // The built program from `binary`, or a null program with `why` set; never throws.
 cl::Program program_from_binary(const cl::Context& context, const cl::Device& device,
                                 const std::vector<unsigned char>& binary,
@@ -180,22 +197,6 @@ std::vector<unsigned char> program_binary(const cl::Program& program, const cl::
         if (devices[i]() == device()) return std::move(binaries[i]);
     return {};
 }
-
-// The environment's compiler settings of the OpenCL implementations whose binaries this cache
-// holds, sorted: Intel's CPU runtime reads CL_CONFIG_* (its vectoriser among them) when it builds
-// a program, so a binary built under one setting is not the binary of another. (PoCL's programs
-// do not come through this cache: it keeps its own.)
-std::string compiler_environment() {
-    std::vector<std::string> entries;
-    for (char** e = environ; e && *e; ++e)
-        if (std::strncmp(*e, "CL_CONFIG_", 10) == 0) entries.emplace_back(*e);
-    std::sort(entries.begin(), entries.end());
-    std::string joined;
-    for (const std::string& entry : entries) joined += entry + "\n";
-    return joined;
-}
-
-}  // namespace
 
 std::string BinaryCacheKey::hex() const {
     char text[33];
@@ -279,10 +280,24 @@ static int count_miss(const std::string& counter) {
     return misses;
 }
 
+// From source, in a child process when asked (build_child.h): its binary loaded here.
+static cl::Program build_from_source(const cl::Context& context, const cl::Device& device,
+                                     const DeviceInfo& info, const std::string& source,
+                                     const std::string& options, bool in_child) {
+    if (!in_child) return build_program(context, device, source, options);
+    std::vector<unsigned char> binary = build_binary_in_child(info, source, options);
+    std::string why;
+    cl::Program program = program_from_binary(context, device, binary, options, why);
+    if (!program())
+        throw RuntimeError("device '" + info.name + "' refused the binary its own build made (" +
+                           why + ")");
+    return program;
+}
+
 cl::Program build_program_cached(const cl::Context& context, const cl::Device& device,
                                  const DeviceInfo& info, const std::string& source,
                                  const std::string& options, BuildReport* report,
-                                 int store_after_misses) {
+                                 int store_after_misses, bool in_child) {
     const auto t0 = std::chrono::steady_clock::now();
     BuildReport local;
     BuildReport& r = report ? *report : local;
@@ -290,7 +305,7 @@ cl::Program build_program_cached(const cl::Context& context, const cl::Device& d
 
     const std::string directory = binary_cache_directory();
     if (directory.empty()) {
-        cl::Program program = build_program(context, device, source, options);
+        cl::Program program = build_from_source(context, device, info, source, options, in_child);
         r.seconds = seconds_since(t0);
         return program;
     }
@@ -311,7 +326,7 @@ cl::Program build_program_cached(const cl::Context& context, const cl::Device& d
 
     // Miss or rejected entry: build from source (a failing build throws) and store the binary,
     // or count the miss while fewer than store_after_misses - 1 came before.
-    cl::Program program = build_program(context, device, source, options);
+    cl::Program program = build_from_source(context, device, info, source, options, in_child);
     const std::string counter = (fs::path(directory) / (key.hex() + ".misses")).string();
     if (store_after_misses > 1 && count_miss(counter) + 1 < store_after_misses) {
         r.store_deferred = true;

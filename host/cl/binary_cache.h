@@ -73,9 +73,19 @@ struct BuildReport {
 // (counted in <key>.misses beside the entry). For a driver whose own cache makes a rebuild
 // cheap and asking for the binary dear (PoCL: about 1 s of code generation per variant), a
 // variant built once or twice never pays for a binary that would not be read.
+// With `in_child`, the build from source runs in a child process (build_child.h), so that a
+// compiler crash costs the build (CompilerCrash), not the process.
 cl::Program build_program_cached(const cl::Context& context, const cl::Device& device,
                                  const DeviceInfo& info, const std::string& source,
                                  const std::string& options, BuildReport* report = nullptr,
-                                 int store_after_misses = 1);
+                                 int store_after_misses = 1, bool in_child = false);
+
+// The built program from `binary`, or a null program with `why` set; never throws.
+cl::Program program_from_binary(const cl::Context& context, const cl::Device& device,
+                                const std::vector<unsigned char>& binary,
+                                const std::string& options, std::string& why);
+
+// The binary of `program` for `device`, empty when the driver gives none.
+std::vector<unsigned char> program_binary(const cl::Program& program, const cl::Device& device);
 
 }  // namespace mcrt

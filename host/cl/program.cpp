@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cl/binary_cache.h"
+#include "cl/build_child.h"
 #include "cl/cl_error.h"
 
 namespace mcrt {
@@ -132,9 +133,14 @@ cl::Program cached_program(const DeviceContext& device, const std::string& file,
     bool driver_caches = device.info.platform_name.find("Portable Computing Language") !=
                              std::string::npos &&
                          !(pocl_cache && std::string(pocl_cache) == "0");
+    // Where the binary is stored at the first build anyway, the build runs in a child process
+    // (build_child.h): a vendor compiler's crash then costs the device, not mcrt. PoCL's builds
+    // stay in this process: asking it for the binary costs a second code generation.
+    const bool in_child = !driver_caches && !build_child_executable().empty();
     cl::Program program = build_program_cached(device.context, device.info.device, device.info,
                                                source, options, nullptr,
-                                               driver_caches ? kDriverCachesStoreAfterMisses : 1);
+                                               driver_caches ? kDriverCachesStoreAfterMisses : 1,
+                                               in_child);
     programs.emplace(key, program);
     return program;
 }

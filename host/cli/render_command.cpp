@@ -27,6 +27,7 @@
 #include "render/memory_estimate.h"
 #include "render/render_program.h"
 #include "render/renderer.h"
+#include "cl/build_child.h"
 #include "render/variants.h"
 #include "scene/gltf_import.h"
 
@@ -42,6 +43,7 @@ extern "C" void on_interrupt(int) { g_interrupted = 1; }
 struct InterruptGuard {
     InterruptGuard() {
         g_interrupted = 0;
+        set_build_stop_flag(&g_interrupted);  // a kernel build in a child process stops too
         struct sigaction action {};
         action.sa_handler = on_interrupt;
         action.sa_flags = SA_RESETHAND;

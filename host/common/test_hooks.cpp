@@ -29,4 +29,9 @@ void test_pause(const char* point) {
 
 bool test_no_tmpfile() { return std::getenv("MCRT_TEST_NO_TMPFILE") != nullptr; }
 
+bool test_wrong_device(int device) {
+    const char* text = std::getenv("MCRT_TEST_WRONG_DEVICE");
+    return text != nullptr && *text != '\0' && std::to_string(device) == text;
+}
+
 }  // namespace mcrt

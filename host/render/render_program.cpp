@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "common/error.h"
+#include "common/test_hooks.h"
 #include "render/renderer.h"
 #include "render/variants.h"
 #include "shared_types.h"
@@ -94,8 +95,9 @@ std::string first_error_in(const std::string& log, const std::string& file) {
 cl::Program render_program(const DeviceContext& device, const RenderSettings& settings,
                            bool microfacet) {
     try {
-        return cached_program(device, "render.cl", render_program_options(settings, microfacet),
-                              render_program_replacements(settings));
+        std::string options = render_program_options(settings, microfacet);
+        if (test_wrong_device(device.info.index)) options += " -D MCRT_TEST_WRONG_VALUES";
+        return cached_program(device, "render.cl", options, render_program_replacements(settings));
     } catch (const RuntimeError& e) {
         if (settings.estimator_file.empty()) throw;
         std::string what = e.what();
