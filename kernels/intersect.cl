@@ -6,13 +6,10 @@
 #include "geometry.cl"
 
 /* The edge functions of a shared edge must round identically in both triangles: a fused
- * multiply-add in one and not the other would open cracks (Woop et al. 2013, sec. 4). */
+ * multiply-add in one and not the other would open cracks (Woop et al. 2013, sec. 4). Contraction
+ * is off in every program (shared_types.h); said again here, where it matters twice. */
 #pragma OPENCL FP_CONTRACT OFF
 
-#if defined(cl_khr_fp64)
-#pragma OPENCL EXTENSION cl_khr_fp64 : enable
-#define MCRT_HAVE_FP64 1
-#endif
 
 /* The ray as the four-lane test reads it: its origin on the permuted axes kx, ky, kz and its
  * shear, splatted, and the permutation as indices into TrianglePacket.v. */
@@ -155,6 +152,4 @@ inline float lane_t_rounding_bound(const PacketRay* q, global const TrianglePack
     return lane == 0u ? d.x : lane == 1u ? d.y : lane == 2u ? d.z : d.w;
 }
 
-/* Contraction is harmless, and faster, in the rest of the program. */
-#pragma OPENCL FP_CONTRACT ON
 #endif

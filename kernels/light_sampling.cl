@@ -124,7 +124,7 @@ inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint*
     float3 to_light = lp.p - sp->p;
     float d2 = dot(to_light, to_light);
     if (!(d2 > 0.0f)) return ls;
-    float3 wi = to_light * rsqrt(d2);
+    float3 wi = to_light * (1.0f / sqrt(d2));
     float3 n_light = light_normal(&light);
     float cos_y = light_emitting_cosine(&light, n_light, wi);
     if (cos_y <= 0.0f) return ls; /* the light's back face */
@@ -189,7 +189,7 @@ inline LightSample sample_light_solid_angle(const SceneView* scene, const Surfac
         float3 to_light = lp.p - x;
         float d2 = dot(to_light, to_light);
         if (!(d2 > 0.0f)) return ls;
-        wi = to_light * rsqrt(d2);
+        wi = to_light * (1.0f / sqrt(d2));
         float cos_y = light_emitting_cosine(&light, n_light, wi);
         if (cos_y <= 0.0f) return ls;
         pdf_w = pdf_area_to_solid_angle(lp.pdf_a, d2, cos_y);

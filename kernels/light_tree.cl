@@ -17,7 +17,7 @@ inline float sin_sub_clamped(float sin_a, float cos_a, float sin_b, float cos_b)
     return cos_a > cos_b ? 0.0f : sin_a * cos_b - cos_a * sin_b;
 }
 
-inline float safe_sqrt1m(float c) { return native_sqrt(max(0.0f, 1.0f - c * c)); }
+inline float safe_sqrt1m(float c) { return sqrt(max(0.0f, 1.0f - c * c)); }
 
 /* Importance of a node at the shading point p with unit normal n (on the side the light must
  * reach): φ · cosθ'_light / d² · cosθ'_receiver, where the primes are the least angles that
@@ -34,7 +34,7 @@ inline float light_node_importance(global const LightTreeNode* node, float3 p, f
      * comparing a squared distance with a length (its scale-dependent slip); this compares
      * squares. */
     float d2_clamped = max(d2, r2);
-    float inv_d = d2 > 0.0f ? native_rsqrt(d2) : 0.0f;
+    float inv_d = d2 > 0.0f ? 1.0f / sqrt(d2) : 0.0f;
     float3 wi = d2 > 0.0f ? to_p * inv_d : (float3)(0.0f, 0.0f, 1.0f); /* light → p */
 
     /* θ_w: between the cone's axis and the direction to p; either way for two-sided lights. */

@@ -40,13 +40,13 @@ inline float ggx_visibility(float cos_o, float cos_i, float alpha) {
  * point uniform on the spherical cap z ≥ −wo_z of the unit sphere, then unstretched. */
 inline float3 ggx_sample_visible_normal(float3 wo, float alpha, float2 u) {
     float3 w = normalize((float3)(wo.x * alpha, wo.y * alpha, wo.z));
-    float phi = 2.0f * M_PI_F * u.x;
+    float turns = 2.0f * u.x; /* φ = π · turns */
     float z = fma(1.0f - u.y, 1.0f + w.z, -w.z);
     float sin_theta = sqrt(clamp(1.0f - z * z, 0.0f, 1.0f));
-    float3 h = (float3)(sin_theta * cos(phi), sin_theta * sin(phi), z) + w;
+    float3 h = (float3)(sin_theta * cospi(turns), sin_theta * sinpi(turns), z) + w;
     float3 m = (float3)(h.x * alpha, h.y * alpha, h.z);
     float len2 = dot(m, m);
-    return len2 > 0.0f ? m * rsqrt(len2) : (float3)(0.0f, 0.0f, 1.0f);
+    return len2 > 0.0f ? m * (1.0f / sqrt(len2)) : (float3)(0.0f, 0.0f, 1.0f);
 }
 
 /* Density with respect to solid angle of wi = reflect(−wo, m) for m ~ D_wo: D_wo(m)/(4 wo·m) =
@@ -57,7 +57,7 @@ inline float ggx_reflection_pdf_w(float3 wo, float3 wi, float alpha) {
     float3 h = wo + wi;
     float len2 = dot(h, h);
     if (!(wo.z > 0.0f) || !(len2 > 0.0f)) return 0.0f;
-    float3 m = h * rsqrt(len2);
+    float3 m = h * (1.0f / sqrt(len2));
     return ggx_g1(wo.z, alpha) * ggx_d(m, alpha) / (4.0f * wo.z);
 }
 

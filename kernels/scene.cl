@@ -61,8 +61,8 @@ inline SurfacePoint surface_point(const SceneView* scene, const Ray* r, const Hi
      * sums) is added to the bound. */
     double3 o = convert_double3(r->org), dir = convert_double3(r->dir);
     double3 d0 = convert_double3(p0);
-    double3 nd = cross(convert_double3(p1) - d0, convert_double3(p2) - d0);
-    double t = dot(d0 - o, nd) / dot(dir, nd);
+    double3 nd = mcrt_cross_double3(convert_double3(p1) - d0, convert_double3(p2) - d0);
+    double t = mcrt_dot_double3(d0 - o, nd) / mcrt_dot_double3(dir, nd);
     if (isfinite(t) && t > 0.0) {
         double3 pd = o + t * dir;
         /* Rounded to nearest, then one float back toward the origin where that went past pd

@@ -5,6 +5,14 @@
 #ifndef MCRT_SHARED_TYPES_H
 #define MCRT_SHARED_TYPES_H
 
+#ifdef __OPENCL_VERSION__
+/* No a·b + c fused into one rounding anywhere: every device then rounds each operation alike,
+ * and an image is the same bits whichever device renders it (docs/DESIGN.md, "Determinism"). It
+ * holds to the end of each program, user estimator files included. */
+#pragma OPENCL FP_CONTRACT OFF
+#include "arithmetic.cl"
+#endif
+
 #ifndef __OPENCL_VERSION__
 #include <cstddef>
 #include <cstdint>
