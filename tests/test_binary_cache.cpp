@@ -392,6 +392,8 @@ TEST_CASE("cached_program stores the render kernel in the binary cache", "[cache
     CHECK(program());
     CHECK(cache.files().size() == 1);
     BuildReport report;
-    build(device, kernel_source("render.cl"), "-D MCRT_ESTIMATE=estimate_light_area", report);
+    // cached_program adds the device's own options (device_program_options) to the key.
+    build(device, kernel_source("render.cl"),
+          "-D MCRT_ESTIMATE=estimate_light_area" + device_program_options(device.info), report);
     CHECK(report.cache_hit);
 }

@@ -234,3 +234,80 @@ TEST_CASE("a time limit or SIGINT writes a valid partial image of whole chunks",
         CHECK(same_bits(img.rgb, read_exr(full).rgb));
     }
 }
+
+// With an environment variable set for one child process only.
+struct ScopedEnv {
+    std::vector<std::string> names;
+    ScopedEnv(std::initializer_list<std::pair<const char*, const char*>> vars) {
+        for (const auto& [name, value] : vars) setenv(name, value, 1), names.emplace_back(name);
+    }
+    ~ScopedEnv() {
+        for (const std::string& name : names) unsetenv(name.c_str());
+    }
+};
+
+TEST_CASE("a device that computes wrong values is retired before its samples enter the image",
+          "[multidevice][cli][agreement]") {
+    TempDir dir;
+    const std::vector<std::string> common = {"render", kCornell, "--width", "40", "--height", "32",
+                                             "--spp", "48", "--estimator", "mis", "--quiet"};
+    auto with = [&](std::vector<std::string> extra) {
+        std::vector<std::string> a = common;
+        a.insert(a.end(), extra.begin(), extra.end());
+        return a;
+    };
+    ProcessResult one = run_process(MCRT_EXE, with({"--out", dir / "one.exr", "--device", "0"}), dir.path());
+    REQUIRE(one.exit_code == 0);
+    const Image reference = read_exr(dir / "one.exr");
+    // The hook scales every sample of the named device by 1 + 2^-20: the 64 agreement pixels
+    // differ, so the device is retired with one warning and the image is device 0's alone.
+    ScopedEnv wrong({{"MCRT_TEST_WRONG_DEVICE", "1"}});
+    ProcessResult r = run_process(MCRT_EXE, with({"--out", dir / "all.exr", "--device", "all",
+                                                  "--stats", dir / "all.json"}), dir.path());
+    INFO("stderr: " << r.err);
+    REQUIRE(r.exit_code == 0);
+    std::vector<std::string> warnings = lines_starting_with(r.err, "mcrt: warning:");
+    REQUIRE(warnings.size() == 1);
+    CHECK(warnings[0].find("device 1") != std::string::npos);
+    CHECK(warnings[0].find("disagrees with device 0") != std::string::npos);
+    CHECK(warnings[0].find(" against ") != std::string::npos);  // the first differing values
+    CHECK(same_bits(reference.rgb, read_exr(dir / "all.exr").rgb));
+    CHECK(same_bits(reference.variance, read_exr(dir / "all.exr").variance));
+    nlohmann::json stats = nlohmann::json::parse(read_whole_file(dir / "all.json"));
+    REQUIRE(stats["devices"].size() == 2);
+    CHECK(stats["devices"][1]["samples"].get<uint64_t>() == 0);
+}
+
+TEST_CASE("a device whose compiler crashes is retired with one line; with none left, exit 1",
+          "[multidevice][cli][agreement]") {
+    TempDir dir;
+    // PoCL's builds run in a child process (as other drivers' do) when its own cache is off,
+    // and the hook makes the child for device 1 die of SIGSEGV.
+    ScopedEnv env({{"POCL_KERNEL_CACHE", "0"}, {"MCRT_NO_KERNEL_CACHE", "1"},
+                   {"MCRT_TEST_COMPILER_CRASH", "1"}});
+    const std::vector<std::string> common = {"render", kCornell, "--width", "32", "--height", "32",
+                                             "--spp", "16", "--quiet"};
+    auto with = [&](std::vector<std::string> extra) {
+        std::vector<std::string> a = common;
+        a.insert(a.end(), extra.begin(), extra.end());
+        return a;
+    };
+    ProcessResult one = run_process(MCRT_EXE, with({"--out", dir / "one.exr", "--device", "0"}), dir.path());
+    REQUIRE(one.exit_code == 0);
+    ProcessResult all = run_process(MCRT_EXE, with({"--out", dir / "all.exr", "--device", "all"}), dir.path());
+    INFO("stderr: " << all.err);
+    REQUIRE(all.exit_code == 0);
+    std::vector<std::string> warnings = lines_starting_with(all.err, "mcrt: warning:");
+    REQUIRE(warnings.size() == 1);
+    CHECK(warnings[0].find("device 1") != std::string::npos);
+    CHECK(warnings[0].find("SIGSEGV") != std::string::npos);
+    CHECK(warnings[0].find("-D MCRT_ESTIMATE=") != std::string::npos);  // the variant
+    CHECK(same_bits(read_exr(dir / "one.exr").rgb, read_exr(dir / "all.exr").rgb));
+
+    ProcessResult alone = run_process(MCRT_EXE, with({"--out", dir / "alone.exr", "--device", "1"}), dir.path());
+    INFO("stderr: " << alone.err);
+    CHECK(alone.exit_code == 1);
+    CHECK(lines_starting_with(alone.err, "mcrt: error:").size() == 1);
+    CHECK(alone.err.find("SIGSEGV") != std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(dir / "alone.exr"));
+}

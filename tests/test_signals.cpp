@@ -98,3 +98,32 @@ TEST_CASE("A render that finishes under a late SIGTERM still writes its whole im
                     dir.path(), 90, SIGTERM, 1.5);
     check_outputs(dir.path(), r, 32, 32);
 }
+
+TEST_CASE("SIGTERM ends a render on a slow device within seconds", "[signals][cli]") {
+    // MCRT_SLOW_DEVICE=0:40 makes device 0 forty times slower (each launch sleeps 39 times its
+    // busy time). Launches are sized by the device's own measured speed to about 150 ms, so a
+    // stop is seen within a launch or two; the first chunk of every pixel is still finished, unless
+    // that is more than 3 s away: then the render is abandoned, writing nothing.
+    setenv("MCRT_SLOW_DEVICE", "0:40", 1);
+    for (int size : {64, 512}) {
+        DYNAMIC_SECTION(size << "x" << size) {
+            TempDir dir("mcrt-signals");
+            const double after = 3.0;
+            const ProcessResult r = run_process(
+                MCRT_EXE,
+                {"render", kCornell, "--width", std::to_string(size), "--height",
+                 std::to_string(size), "--spp", "4096", "--estimator", "mis", "--max-depth", "4",
+                 "--quiet", "--out", dir / "out.exr", "--stats", dir / "out.json"},
+                dir.path(), 120, SIGTERM, after);
+            check_outputs(dir.path(), r, size, size);
+            CHECK(r.seconds < after + 5.0);
+            if (size == 64) {  // the first chunk row is done well before the signal
+                CHECK(r.exit_code == 0);
+            } else {  // 512x512x16 samples at this speed take about a minute
+                CHECK(r.exit_code == 1);
+                CHECK(r.err.find("before every pixel had its first 16 samples") != std::string::npos);
+            }
+        }
+    }
+    unsetenv("MCRT_SLOW_DEVICE");
+}

@@ -29,9 +29,13 @@ void test_pause(const char* point) {
 
 bool test_no_tmpfile() { return std::getenv("MCRT_TEST_NO_TMPFILE") != nullptr; }
 
-bool test_wrong_device(int device) {
-    const char* text = std::getenv("MCRT_TEST_WRONG_DEVICE");
+static bool names_device(const char* variable, int device) {
+    const char* text = std::getenv(variable);
     return text != nullptr && *text != '\0' && std::to_string(device) == text;
 }
+
+bool test_wrong_device(int device) { return names_device("MCRT_TEST_WRONG_DEVICE", device); }
+
+bool test_compiler_crash(int device) { return names_device("MCRT_TEST_COMPILER_CRASH", device); }
 
 }  // namespace mcrt

@@ -19,4 +19,8 @@ bool test_no_tmpfile();
 // device that computes slightly wrong values for the agreement check to catch.
 bool test_wrong_device(int device);
 
+// True when MCRT_TEST_COMPILER_CRASH names device index `device`: a child build for it
+// (host/cl/build_child.h) dies of SIGSEGV, as Intel's compiler did.
+bool test_compiler_crash(int device);
+
 }  // namespace mcrt

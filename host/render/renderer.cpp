@@ -1,6 +1,7 @@
 #include "render/renderer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <deque>
@@ -204,7 +205,18 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
     };
     // Each device keeps up to pipeline_depth() items started (one until its first result has
     // measured its speed, so that the second is sized by it), and commits them in order.
+    std::atomic<size_t> loops_ended{0};
     auto device_loop = [&](RenderWorker& worker, std::optional<WorkItem> item) {
+        struct Ended {  // counted however the loop ends, under the lock the watch loop waits on
+            std::atomic<size_t>& n;
+            std::mutex& m;
+            std::condition_variable& cv;
+            ~Ended() {
+                std::lock_guard<std::mutex> lock(m);
+                ++n;
+                cv.notify_all();
+            }
+        } ended{loops_ended, acc_mutex, progress_made};
         std::deque<WorkItem> started;
         for (;;) {
             BatchResult r;
@@ -269,33 +281,45 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
             if (!w->report.retired) return false;
         return true;
     };
+    // After a stop the first chunk row is finished (so that every pixel has samples), unless
+    // that takes more than kStopGraceSeconds (a slow device): then the render is abandoned.
+    constexpr double kStopGraceSeconds = 3.0;
+    double stopped_at = 0;
     for (;;) {
         {
             std::lock_guard<std::mutex> lock(acc_mutex);
             if (progress) progress(acc.committed_spp(), settings.spp, device_reports());
-            if (acc.committed_spp() >= settings.spp || all_retired()) break;
+            if (acc.committed_spp() >= settings.spp || all_retired() ||
+                loops_ended == threads.size())
+                break;
         }
         double elapsed = seconds_since(start);
-        if (result.stopped_by.empty() && control.time_limit > 0 && elapsed >= control.time_limit) {
+        if (result.stopped_by.empty() && control.time_limit > 0 && elapsed >= control.time_limit)
             result.stopped_by = "time limit";
-            queue.stop();
-        }
-        if (result.stopped_by.empty() && control.interrupted && *control.interrupted) {
+        if (result.stopped_by.empty() && control.interrupted && *control.interrupted)
             result.stopped_by = "interrupt";
-            queue.stop();
+        if (!result.stopped_by.empty() && stopped_at == 0) {
+            stopped_at = elapsed;
+            queue.stop();  // hand-out stops after the first chunk row; in-flight work drains
         }
-        if (queue.stopped()) {
-            // Wait for the threads: hand-out has stopped, in-flight work drains.
-            break;
+        if (stopped_at > 0 && elapsed - stopped_at > kStopGraceSeconds) {
+            std::lock_guard<std::mutex> lock(acc_mutex);
+            if (acc.committed_spp() == 0) queue.abandon();
         }
         std::unique_lock<std::mutex> lock(acc_mutex);
         progress_made.wait_for(lock, std::chrono::milliseconds(20), [&] {
-            return acc.committed_spp() >= settings.spp || all_retired();
+            return acc.committed_spp() >= settings.spp || all_retired() ||
+                   loops_ended == threads.size();
         });
     }
     for (std::thread& t : threads) t.join();
     result.seconds_render_wall = seconds_since(start) - result.seconds_build;
 
+    if (acc.committed_spp() == 0 && !result.stopped_by.empty())
+        throw RuntimeError("stopped by " + result.stopped_by +
+                           " before every pixel had its first " +
+                           std::to_string(std::min<uint32_t>(MCRT_SAMPLES_PER_CHUNK, settings.spp)) +
+                           " samples; no image was written");
     if (acc.committed_spp() == 0 || (result.stopped_by.empty() && acc.committed_spp() < settings.spp))
         throw RuntimeError("every device failed; no image was completed");
     if (progress) progress(acc.committed_spp(), settings.spp, device_reports());

@@ -17,6 +17,7 @@ uint32_t WorkQueue::samples_in_chunk(uint32_t chunk) const {
 std::optional<WorkItem> WorkQueue::take(uint64_t target_samples, bool wait) {
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
+        if (abandoned_) return std::nullopt;
         if (!redo_.empty()) {
             WorkItem item = redo_.front();
             redo_.pop_front();
@@ -76,6 +77,12 @@ void WorkQueue::give_back(const WorkItem& item) {
 void WorkQueue::stop() {
     std::lock_guard<std::mutex> lock(mutex_);
     stopped_ = true;
+    changed_.notify_all();
+}
+
+void WorkQueue::abandon() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopped_ = abandoned_ = true;
     changed_.notify_all();
 }
 

@@ -36,6 +36,9 @@ public:
     // Stops handing out new items once the first chunk row is handed out, so a stopped render
     // still completes at least one sample per pixel.
     void stop();
+    // Stops handing out anything, the first chunk row's rest too (a stop that the first row would
+    // hold up for long on a slow device): the render then has no image.
+    void abandon();
     bool stopped() const;
     uint32_t samples_in_chunk(uint32_t chunk) const;
 
@@ -46,7 +49,7 @@ private:
     uint32_t next_chunk_ = 0, next_pixel_ = 0;
     uint64_t next_seq_ = 0;
     int in_flight_ = 0;
-    bool stopped_ = false;
+    bool stopped_ = false, abandoned_ = false;
     std::deque<WorkItem> redo_;
 };
 

@@ -1,0 +1,84 @@
+// One image whatever implementation renders it: with two OpenCL implementations present (PoCL
+// and Intel's CPU runtime under scripts/with-intel, as .ci/run runs this), each one's EXR and
+// that of --device all over both are the same bytes, for the determinism configurations. With
+// one implementation the cases skip.
+#include <catch2/catch.hpp>
+
+#include <map>
+
+#include <nlohmann/json.hpp>
+
+#include "cl/device.h"
+#include "process_support.h"
+#include "test_support.h"
+
+using namespace mcrt;
+using namespace mcrt::test;
+
+namespace {
+
+const std::string kCornell = std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf";
+const std::string kGlossy = std::string(MCRT_SCENES) + "/glossy/cornell-metal-block.gltf";
+const std::string kVeach = std::string(MCRT_SCENES) + "/veach-mis/veach-mis.gltf";
+
+// The first device of each platform, by index, keyed by platform name.
+std::map<std::string, int> one_device_per_platform() {
+    std::map<std::string, int> first;
+    for (const DeviceInfo& d : enumerate_devices([](const std::string& w) { WARN(w); }))
+        first.emplace(d.platform_name, d.index);
+    return first;
+}
+
+struct Configuration {
+    const char* name;
+    std::string scene;
+    std::vector<std::string> options;
+};
+
+}  // namespace
+
+TEST_CASE("every OpenCL implementation renders the same bytes, alone and together",
+          "[vendors][determinism]") {
+    const std::map<std::string, int> platforms = one_device_per_platform();
+    if (platforms.size() < 2)
+        skip_test("one OpenCL implementation present (run under scripts/with-intel for two)");
+    const std::vector<Configuration> configurations = {
+        {"direct light-area", kCornell, {"--estimator", "light-area"}},
+        {"glossy mis", kGlossy, {"--estimator", "mis", "--materials", "gltf"}},
+        {"Sobol mis on veach-mis", kVeach, {"--estimator", "mis", "--sampler", "sobol"}},
+        {"depth-8 paths", kCornell, {"--estimator", "mis", "--max-depth", "8"}},
+        {"light tree, ambient sky", kCornell,
+         {"--estimator", "light-solid-angle", "--light-select", "tree", "--sky", "0.3"}},
+    };
+    TempDir dir;
+    for (const Configuration& c : configurations) {
+        DYNAMIC_SECTION(c.name) {
+            std::vector<std::string> common = {"render", c.scene, "--width", "40", "--height",
+                                               "32", "--spp", "48", "--quiet"};
+            common.insert(common.end(), c.options.begin(), c.options.end());
+            auto render = [&](const std::string& device, const std::string& out) {
+                std::vector<std::string> args = common;
+                args.insert(args.end(), {"--device", device, "--out", dir / out, "--stats",
+                                         dir / (out + ".json")});
+                ProcessResult r = run_process(MCRT_EXE, args, dir.path(), 600);
+                INFO("--device " << device << ": " << r.err);
+                REQUIRE(r.exit_code == 0);
+                CHECK(lines_starting_with(r.err, "mcrt: warning:").empty());
+                return read_whole_file(dir / out);
+            };
+            std::string reference;
+            for (const auto& [platform, index] : platforms) {
+                std::string bytes = render(std::to_string(index), "one.exr");
+                INFO("platform " << platform);
+                if (reference.empty())
+                    reference = bytes;
+                else
+                    CHECK(bytes == reference);
+            }
+            CHECK(render("all", "all.exr") == reference);
+            // Every device took part: none was retired by the agreement check.
+            nlohmann::json stats = nlohmann::json::parse(read_whole_file(dir / "all.exr.json"));
+            for (const auto& d : stats["devices"]) CHECK(d["samples"].get<uint64_t>() > 0);
+        }
+    }
+}
