@@ -10,18 +10,7 @@
  * p.pixel_begin + g / p.batch_samples < p.pixel_end (samples of a pixel adjacent) along a path
  * of at most p.max_depth reflections (path.cl) and writes samples[g] = (the radiance's bits, the
  * packed PathRecord). Arguments in the order of RenderArgument. */
-/* Not vectorised across work-items on Intel's CPU runtime (the host defines
- * MCRT_INTEL_NO_VECTORIZE there; other compilers warn of the unknown attribute): its
- * whole-function vectoriser (vplan-vec, 2026.2) crashes on most variants of this kernel
- * and miscompiles the rest — with the path loop compiled in, even where a direct-lighting render
- * never runs it, the surface point an estimator reads is garbage, though the same code is right
- * unvectorised, under -cl-opt-disable, and with the loop removed (docs/ROBUSTNESS.md). */
-#if defined(MCRT_INTEL_NO_VECTORIZE)
-#define MCRT_RENDER_ATTRIBUTES __attribute__((intel_vec_len_hint(1)))
-#else
-#define MCRT_RENDER_ATTRIBUTES
-#endif
-kernel MCRT_RENDER_ATTRIBUTES void render(global const Bvh4Node* nodes, global const TrianglePacket* packets,
+kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                    global const TriangleInfo* triangle_info, global const Material* materials,
                    global const Light* lights, global const float* light_cdf,
                    global const AliasEntry* light_alias, global const LightTreeNode* light_tree,

@@ -11,6 +11,15 @@
  * holds to the end of each program, user estimator files included. */
 #pragma OPENCL FP_CONTRACT OFF
 #include "arithmetic.cl"
+
+/* Intel's CPU runtime (2026.2), where the host defines MCRT_INTEL_NO_VECTORIZE: every kernel
+ * runs one work-item at a time, as on PoCL, instead of vectorised across work-items. Its
+ * vectoriser returns wrong values from any function it does not inline that returns a float3
+ * (four lines show it: docs/ROBUSTNESS.md), which mcrt's larger functions are, and crashes on
+ * most render variants. */
+#if defined(MCRT_INTEL_NO_VECTORIZE)
+#define kernel __kernel __attribute__((intel_vec_len_hint(1)))
+#endif
 #endif
 
 #ifndef __OPENCL_VERSION__

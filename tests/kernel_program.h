@@ -17,9 +17,10 @@ struct KernelProgram {
     DeviceContext device = first_device();
     cl::Program program;
 
+    // Built as mcrt builds its own programs (cached_program): with the device's arithmetic and
+    // workaround options, in a child process where mcrt's would be.
     KernelProgram(const std::string& file, const std::string& options)
-        : program(build_program(device.context, device.info.device, kernel_source(file),
-                                options)) {}
+        : program(cached_program(device, file, options)) {}
 
     // A read-write copy of v (one element when v is empty: never a zero-sized buffer).
     template <typename T>

@@ -100,8 +100,7 @@ TEST_CASE("the device sees every shared struct with the host's size, alignment a
     REQUIRE(want.size() > 40);
 
     DeviceContext device = first_device();
-    cl::Program program = build_program(device.context, device.info.device, kernel_source("render.cl"),
-                                        "-D MCRT_ESTIMATE=estimate_light_area");
+    cl::Program program = cached_program(device, "render.cl", "-D MCRT_ESTIMATE=estimate_light_area");
     cl::Kernel kernel = make_kernel(program, "shared_type_layout");
     cl_int status;
     cl::Buffer layout(device.context, CL_MEM_WRITE_ONLY, want.size() * sizeof(cl_uint), nullptr, &status);

@@ -25,8 +25,7 @@ struct RaySet {
 
 struct Tracer {
     DeviceContext device = first_device();
-    cl::Program program =
-        build_program(device.context, device.info.device, kernel_source("trace.cl"), "");
+    cl::Program program = cached_program(device, "trace.cl", "");
 
     template <typename T>
     cl::Buffer buffer(const std::vector<T>& v) {
