@@ -24,14 +24,19 @@ int run_devices() {
     std::vector<DeviceInfo> devices = enumerate_devices(print_warning);
     if (devices.empty()) throw RuntimeError(no_device_message());
     for (const DeviceInfo& d : devices) {
+        // What the device does not promise of IEEE-754 arithmetic (docs/DESIGN.md, "Data flow").
+        std::string caveats;
+        if (!(d.single_fp_config & CL_FP_DENORM)) caveats += "may flush denormals";
+        if (!(d.single_fp_config & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT))
+            caveats += std::string(caveats.empty() ? "" : ", ") +
+                       "does not promise correctly rounded division and sqrt";
+        if (!caveats.empty())
+            caveats = " (" + caveats + ": the agreement check guards its images)";
         std::printf("%d: %s [%s] — %s (%s), %s, %u compute units, %.1f GiB, driver %s%s\n",
                     d.index, d.name.c_str(), d.type_name().c_str(), d.platform_name.c_str(),
                     d.platform_vendor.c_str(), d.version.c_str(), d.compute_units,
                     double(d.global_memory) / (1 << 30), d.driver_version.c_str(),
-                    d.ieee_basic_operations()
-                        ? ""
-                        : " (flushes denormals or rounds division or sqrt loosely: its images "
-                          "may differ from other devices' in the last bits)");
+                    caveats.c_str());
     }
     return 0;
 }
