@@ -183,7 +183,10 @@ int run_build_program_child(const std::string& dir_text, int device_index) {
         if (device_index < 0 || size_t(device_index) >= devices.size())
             throw std::runtime_error("build-program: no device " + std::to_string(device_index));
         DeviceContext device(devices[size_t(device_index)]);
-        if (test_compiler_crash(device_index)) std::raise(SIGSEGV);
+        if (test_compiler_crash(device_index)) {
+            std::signal(SIGSEGV, SIG_DFL);  // past a sanitizer's handler: die of the signal
+            std::raise(SIGSEGV);
+        }
         cl::Program program = build_program(device.context, device.info.device,
                                             read_text(dir / "source.cl"), read_text(dir / "options"));
         std::vector<unsigned char> binary = program_binary(program, device.info.device);
