@@ -116,7 +116,11 @@ uint64_t DeviceWorker::target_samples() const {
     if (fixed_batch_ > 0) return fixed_batch_;
     if (report.seconds_busy <= 0) return 1024;  // the probe failed to measure anything
     double rate = double(report.samples) / (report.seconds_busy * slow_factor_);
-    return std::clamp<uint64_t>(uint64_t(rate * kTargetLaunchSeconds), 1024, max_samples_);
+    // At most four times the largest launch so far: a first launch's time measures a slow
+    // device poorly (its build, its first specialisation), and one long launch cannot be stopped.
+    const uint64_t grown = std::max<uint64_t>(1024, 4 * largest_launch_);
+    return std::clamp<uint64_t>(uint64_t(rate * kTargetLaunchSeconds), 1024,
+                                std::min(max_samples_, grown));
 }
 
 BatchResult DeviceWorker::run(const WorkItem& item) {
@@ -205,6 +209,7 @@ BatchResult DeviceWorker::finish() {
 void DeviceWorker::commit_report() {
     report.seconds_busy += pending_busy_;
     report.samples += pending_samples_;
+    largest_launch_ = std::max(largest_launch_, pending_samples_);
     report.batches += 1;
 }
 

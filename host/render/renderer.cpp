@@ -268,7 +268,9 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
     // and none is starved by a faster one that starts first; the probes leave most of the work
     // to the dynamic phase.
     const uint64_t total_samples = uint64_t(pixels) * settings.spp;
-    const uint64_t probe = std::clamp<uint64_t>(total_samples / (8 * workers.size()), 1024, 1 << 16);
+    // Small (at most 4096 samples: a device a thousand times slower than PoCL still answers
+    // within a second), then each device's launches grow by its own measured speed.
+    const uint64_t probe = std::clamp<uint64_t>(total_samples / (8 * workers.size()), 1024, 4096);
     std::vector<std::thread> threads;
     for (auto& w : workers)
         if (!w->report.retired)
