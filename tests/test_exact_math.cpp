@@ -169,6 +169,18 @@ size_t mismatches(const std::vector<V>& a, const std::vector<V>& b, const char* 
     return n;
 }
 
+// The outputs of one-input entry point `kernel` over `inputs` on the optimised build, checked
+// bit for bit against the -cl-opt-disable build of the same source.
+template <typename Out, typename In>
+std::vector<Out> run_both_builds(TestDevice& d, const char* kernel, const std::vector<In>& inputs) {
+    cl::Buffer in = d.optimised.input(inputs);
+    std::vector<Out> v = d.optimised.run<Out>(kernel, inputs.size(), 1, in);
+    cl::Buffer in2 = d.unoptimised.input(inputs);
+    CHECK(mismatches(v, d.unoptimised.run<Out>(kernel, inputs.size(), 1, in2),
+                     "-cl-opt-disable") == 0);
+    return v;
+}
+
 // ---- Inputs -----------------------------------------------------------------------------------
 
 // A random finite float: sign, exponent in [lo, hi], full mantissa.
@@ -243,11 +255,7 @@ TEST_CASE(
     const size_t half = x.size() / 2;
     for (TestDevice& d : devices()) {
         INFO(d.name);
-        cl::Buffer in = d.optimised.input(x);
-        auto v = d.optimised.run<cl_float4>("sincospi_values", x.size(), 1, in);
-        cl::Buffer in2 = d.unoptimised.input(x);
-        CHECK(mismatches(v, d.unoptimised.run<cl_float4>("sincospi_values", x.size(), 1, in2),
-                         "-cl-opt-disable") == 0);
+        auto v = run_both_builds<cl_float4>(d, "sincospi_values", x);
 
         MaxError sin_error, cos_error;
         size_t twin = 0, special = 0, asymmetric = 0, aperiodic = 0, sincos = 0;
@@ -341,11 +349,7 @@ TEST_CASE(
     const size_t third = p.size() / 3;
     for (TestDevice& d : devices()) {
         INFO(d.name);
-        cl::Buffer in = d.optimised.input(p);
-        auto v = d.optimised.run<cl_float2>("atan2_hypot_values", p.size(), 1, in);
-        cl::Buffer in2 = d.unoptimised.input(p);
-        CHECK(mismatches(v, d.unoptimised.run<cl_float2>("atan2_hypot_values", p.size(), 1, in2),
-                         "-cl-opt-disable") == 0);
+        auto v = run_both_builds<cl_float2>(d, "atan2_hypot_values", p);
 
         MaxError atan2_error, hypot_error;
         size_t twin = 0, asymmetric = 0, hypot_axis = 0;

@@ -59,6 +59,11 @@ struct Fixture {
     }
 };
 
+std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
+    a.insert(a.end(), b.begin(), b.end());
+    return a;
+}
+
 std::vector<std::string> warnings;
 void collect_warning(const std::string& w) { warnings.push_back(w); }
 
@@ -169,11 +174,7 @@ TEST_CASE("the command line renders on all devices and reports each one", "[mult
     TempDir dir;
     std::vector<std::string> common = {"render", kCornell, "--width", "40", "--height", "32",
                                        "--spp", "48", "--quiet"};
-    auto with = [&](std::vector<std::string> extra) {
-        std::vector<std::string> a = common;
-        a.insert(a.end(), extra.begin(), extra.end());
-        return a;
-    };
+    auto with = [&](const std::vector<std::string>& extra) { return concat(common, extra); };
     ProcessResult one = run_process(MCRT_EXE, with({"--out", dir / "one.exr", "--device", "0"}), dir.path());
     ProcessResult all = run_process(MCRT_EXE, with({"--out", dir / "all.exr", "--device", "all", "--stats",
                                                     dir / "all.json"}), dir.path());
@@ -251,11 +252,7 @@ TEST_CASE("a device that computes wrong values is retired before its samples ent
     TempDir dir;
     const std::vector<std::string> common = {"render", kCornell, "--width", "40", "--height", "32",
                                              "--spp", "48", "--estimator", "mis", "--quiet"};
-    auto with = [&](std::vector<std::string> extra) {
-        std::vector<std::string> a = common;
-        a.insert(a.end(), extra.begin(), extra.end());
-        return a;
-    };
+    auto with = [&](const std::vector<std::string>& extra) { return concat(common, extra); };
     ProcessResult one = run_process(MCRT_EXE, with({"--out", dir / "one.exr", "--device", "0"}), dir.path());
     REQUIRE(one.exit_code == 0);
     const Image reference = read_exr(dir / "one.exr");
@@ -287,11 +284,7 @@ TEST_CASE("a device whose compiler crashes is retired with one line; with none l
                    {"MCRT_TEST_COMPILER_CRASH", "1"}});
     const std::vector<std::string> common = {"render", kCornell, "--width", "32", "--height", "32",
                                              "--spp", "16", "--quiet"};
-    auto with = [&](std::vector<std::string> extra) {
-        std::vector<std::string> a = common;
-        a.insert(a.end(), extra.begin(), extra.end());
-        return a;
-    };
+    auto with = [&](const std::vector<std::string>& extra) { return concat(common, extra); };
     ProcessResult one = run_process(MCRT_EXE, with({"--out", dir / "one.exr", "--device", "0"}), dir.path());
     REQUIRE(one.exit_code == 0);
     ProcessResult all = run_process(MCRT_EXE, with({"--out", dir / "all.exr", "--device", "all"}), dir.path());
