@@ -48,8 +48,10 @@ void random_lights(size_t n, std::vector<gpu::Light>& lights, std::vector<double
         glm::dvec3 b = glm::cross(nrm, a);
         double size = 0.002 + 0.008 * unit(rng);
         gpu::Light l{};
-        l.p0 = g4(c, float(0.5 * size * size));
-        l.p1 = g4(c + size * a, gpu::as_float(unit(rng) < 0.25 ? MATERIAL_DOUBLE_SIDED : 0u));
+        l.p0 = g4(c);
+        l.p1 = g4(c + size * a);
+        l.area = float(0.5 * size * size);
+        l.flags = unit(rng) < 0.25 ? MATERIAL_DOUBLE_SIDED : 0u;
         l.p2 = g4(c + size * b);
         l.Le = g4(glm::dvec3(1.0));
         lights.push_back(l);
@@ -126,7 +128,7 @@ int main(int argc, char** argv) {
                 build = std::min(build, double(std::clock() - c0) / CLOCKS_PER_SEC);
             }
             uint32_t depth = 0;
-            for (uint32_t x : tree.depth_plus_one) depth = std::max(depth, x - 1);
+            for (const gpu::LightTreePath& path : tree.paths) depth = std::max(depth, path.length - 1);
             cl::Buffer cdf = buffer(d, build_cdf(powers)),
                        alias = buffer(d, build_alias_table(powers)), nodes = buffer(d, tree.nodes);
             double ns[4];

@@ -40,9 +40,9 @@ typedef struct {
 
 inline GltfMaterial gltf_material(const SurfacePoint* sp) {
     GltfMaterial m;
-    m.base = sp->material.albedo.xyz;
-    m.metallic = sp->material.albedo.w;
-    m.alpha = sp->material.Le.w;
+    m.base = sp->material.base_color.xyz;
+    m.metallic = sp->material.metallic;
+    m.alpha = sp->material.alpha;
     m.f0 = sp->material.specular.xyz;
     m.f90 = sp->material.specular.w;
     return m;
@@ -140,7 +140,7 @@ inline float bsdf_pdf_w(const SurfacePoint* sp, float3 wi) {
 
 /* f_r(wo, wi) at sp: albedo/π for directions on the side of the normal, else 0. */
 inline float3 bsdf_eval(const SurfacePoint* sp, float3 wi) {
-    return dot(sp->n, wi) > 0.0f ? sp->material.albedo.xyz * MCRT_INV_PI : (float3)(0.0f);
+    return dot(sp->n, wi) > 0.0f ? sp->material.base_color.xyz * MCRT_INV_PI : (float3)(0.0f);
 }
 
 /* A direction by the BSDF's own density (cosine-weighted for the Lambertian lobe), from u. */
@@ -149,7 +149,7 @@ inline BsdfSample bsdf_sample(const SurfacePoint* sp, float2 u) {
     float3 w = sample_hemisphere_cosine(u);
     BsdfSample s;
     s.wi = frame_to_world(&frame, w);
-    s.f = sp->material.albedo.xyz * MCRT_INV_PI;
+    s.f = sp->material.base_color.xyz * MCRT_INV_PI;
     s.pdf_w = sample_hemisphere_cosine_pdf_w(w);
     s.cos_theta = w.z;
     return s;
@@ -164,6 +164,6 @@ inline float bsdf_pdf_w(const SurfacePoint* sp, float3 wi) {
 #endif
 
 /* The reflectance the ambient estimators use: the course keeps them Lambertian. */
-inline float3 surface_albedo(const SurfacePoint* sp) { return sp->material.albedo.xyz; }
+inline float3 surface_albedo(const SurfacePoint* sp) { return sp->material.base_color.xyz; }
 
 #endif

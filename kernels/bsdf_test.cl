@@ -1,12 +1,12 @@
 /* Test entry points for the glTF BSDF (tests/test_materials.cpp), built with
  * -D MCRT_MATERIALS_GLTF: a surface point on the plane z = 0 (normal +z) seen from direction wo,
- * with the material given as its three packed float4s (shared_types.h, Material). Global sizes
+ * with the material passed by value (shared_types.h, Material). Global sizes
  * are 1D; each entry checks its bound. */
 #include "shared_types.h"
 #include "bsdf.cl"
 #include "rng.cl"
 
-inline SurfacePoint test_surface(float4 albedo, float4 Le, float4 specular, float3 wo) {
+inline SurfacePoint test_surface(Material material, float3 wo) {
     SurfacePoint sp;
     sp.p = sp.p_error = (float3)(0.0f);
     sp.n = (float3)(0.0f, 0.0f, 1.0f);
@@ -14,20 +14,17 @@ inline SurfacePoint test_surface(float4 albedo, float4 Le, float4 specular, floa
     sp.front = true;
     sp.light = 0u;
     sp.lane = MCRT_NO_HIT;
-    sp.material.albedo = albedo;
-    sp.material.Le = Le;
-    sp.material.specular = specular;
-    sp.material.flags = 0u;
+    sp.material = material;
     return sp;
 }
 
 /* Writes out[k] = (wi, pdf_w) and f[k] = (f, cos_theta) of bsdf_sample with u hashed from
  * (k, seed); pdf_w = 0 for no direction. */
-kernel void bsdf_samples(float4 albedo, float4 Le, float4 specular, float4 wo, uint count,
+kernel void bsdf_samples(Material material, float4 wo, uint count,
                          uint seed, global float4* out, global float4* f) {
     uint k = (uint)get_global_id(0);
     if (k >= count) return;
-    SurfacePoint sp = test_surface(albedo, Le, specular, wo.xyz);
+    SurfacePoint sp = test_surface(material, wo.xyz);
     uint4 h = pcg4d((uint4)(k, seed, 0xB5DFu, 0u));
     BsdfSample s = bsdf_sample(&sp, (float2)(uint_to_unit_float(h.x), uint_to_unit_float(h.y)));
     out[k] = (float4)(s.wi, s.pdf_w);
@@ -35,23 +32,23 @@ kernel void bsdf_samples(float4 albedo, float4 Le, float4 specular, float4 wo, u
 }
 
 /* Reads wi[k].xyz; writes pdf[k] = bsdf_pdf_w and f[k].xyz = bsdf_eval at wo. */
-kernel void bsdf_evaluate(float4 albedo, float4 Le, float4 specular, float4 wo, uint count,
+kernel void bsdf_evaluate(Material material, float4 wo, uint count,
                           global const float4* wi, global float* pdf, global float4* f) {
     uint k = (uint)get_global_id(0);
     if (k >= count) return;
-    SurfacePoint sp = test_surface(albedo, Le, specular, wo.xyz);
+    SurfacePoint sp = test_surface(material, wo.xyz);
     pdf[k] = bsdf_pdf_w(&sp, wi[k].xyz);
     f[k] = (float4)(bsdf_eval(&sp, wi[k].xyz), 0.0f);
 }
 
 /* Reads pairs[2k], pairs[2k + 1] (wo, wi); writes f[2k] = f(wo, wi), f[2k + 1] = f(wi, wo). */
-kernel void bsdf_swapped(float4 albedo, float4 Le, float4 specular, uint count,
+kernel void bsdf_swapped(Material material, uint count,
                          global const float4* pairs, global float4* f) {
     uint k = (uint)get_global_id(0);
     if (k >= count) return;
     float3 a = pairs[2 * k].xyz, b = pairs[2 * k + 1].xyz;
-    SurfacePoint sa = test_surface(albedo, Le, specular, a);
-    SurfacePoint sb = test_surface(albedo, Le, specular, b);
+    SurfacePoint sa = test_surface(material, a);
+    SurfacePoint sb = test_surface(material, b);
     f[2 * k] = (float4)(bsdf_eval(&sa, b), 0.0f);
     f[2 * k + 1] = (float4)(bsdf_eval(&sb, a), 0.0f);
 }

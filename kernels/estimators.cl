@@ -43,31 +43,43 @@ inline float3 estimate_light_solid_angle(const SceneView* scene, const SurfacePo
 
 /* ---- Integrating over directions --------------------------------------------------------- */
 
-/* f·Le·cosθ / pdf(ω) for a direction w (local frame, z up) of density pdf_w that finds an
- * emitter, or leaves the scene toward the sky light (GI Compendium eqs. 34, 35). */
+/* f·Le·cosθ / pdf(ω) for a direction w (local frame, z up) of density pdf_w drawn from the
+ * numbers u, that finds an emitter or leaves the scene toward the sky light (GI Compendium
+ * eqs. 34, 35). Where the BSDF samples those numbers to the same direction (cosine directions on
+ * a Lambertian surface), its sample is handed to the path, which continues along it. */
 inline float3 estimate_emitter_along(const SceneView* scene, const SurfacePoint* sp, float3 w,
-                                     float pdf_w, uint* rays) {
+                                     float pdf_w, float2 u, bool by_cosine, uint* rays) {
     if (!(pdf_w > 0.0f) || w.z <= 0.0f) return (float3)(0.0f);
     Frame frame = frame_from_normal(sp->n);
     float3 wi = frame_to_world(&frame, w);
     SurfacePoint seen;
-    float3 Le = trace_from(scene, sp, wi, rays, &seen) ? emitted_radiance(&seen)
-                                                       : environment_radiance(scene);
+    bool found;
+    BsdfSample bs;
+    if (by_cosine && scene->continuation) bs = bsdf_sample(sp, u);
+    if (by_cosine && scene->continuation && all(as_uint3(bs.wi) == as_uint3(wi)))
+        found = trace_bsdf_sample(scene, sp, &bs, rays, &seen);
+    else
+        found = trace_from(scene, sp, wi, rays, &seen);
+    float3 Le = found ? emitted_radiance(&seen) : environment_radiance(scene);
     return bsdf_eval(sp, wi) * Le * (w.z / pdf_w);
 }
 
 /* Directions uniform on the hemisphere, density 1/(2π) (eq. 34). */
 inline float3 estimate_hemisphere_uniform(const SceneView* scene, const SurfacePoint* sp,
                                           const SampleStream* stream, uint* rays) {
-    float3 w = sample_hemisphere_uniform(sample_2d(stream, DIM_DIRECTION));
-    return estimate_emitter_along(scene, sp, w, sample_hemisphere_uniform_pdf_w(w), rays);
+    float2 u = sample_2d(stream, DIM_DIRECTION);
+    float3 w = sample_hemisphere_uniform(u);
+    return estimate_emitter_along(scene, sp, w, sample_hemisphere_uniform_pdf_w(w), u, false,
+                                  rays);
 }
 
 /* Cosine-weighted directions, density cosθ/π (eq. 35). */
 inline float3 estimate_hemisphere_cosine(const SceneView* scene, const SurfacePoint* sp,
                                          const SampleStream* stream, uint* rays) {
-    float3 w = sample_hemisphere_cosine(sample_2d(stream, DIM_DIRECTION));
-    return estimate_emitter_along(scene, sp, w, sample_hemisphere_cosine_pdf_w(w), rays);
+    float2 u = sample_2d(stream, DIM_DIRECTION);
+    float3 w = sample_hemisphere_cosine(u);
+    return estimate_emitter_along(scene, sp, w, sample_hemisphere_cosine_pdf_w(w), u, true,
+                                  rays);
 }
 
 /* Directions by the BSDF's own sampling density (bsdf.cl: cosine on a Lambertian surface, the
@@ -78,8 +90,8 @@ inline float3 estimate_bsdf(const SceneView* scene, const SurfacePoint* sp,
     BsdfSample bs = bsdf_sample(sp, sample_2d(stream, DIM_DIRECTION));
     if (!(bs.pdf_w > 0.0f) || bs.cos_theta <= 0.0f) return (float3)(0.0f);
     SurfacePoint seen;
-    float3 Le = trace_from(scene, sp, bs.wi, rays, &seen) ? emitted_radiance(&seen)
-                                                          : environment_radiance(scene);
+    float3 Le = trace_bsdf_sample(scene, sp, &bs, rays, &seen) ? emitted_radiance(&seen)
+                                                               : environment_radiance(scene);
     return bs.f * Le * (bs.cos_theta / bs.pdf_w);
 }
 
@@ -109,7 +121,7 @@ inline float3 estimate_mis(const SceneView* scene, const SurfacePoint* sp,
     BsdfSample bs = bsdf_sample(sp, sample_2d(stream, DIM_DIRECTION));
     SurfacePoint seen;
     if (bs.pdf_w > 0.0f && bs.cos_theta > 0.0f) {
-        if (trace_from(scene, sp, bs.wi, rays, &seen)) {
+        if (trace_bsdf_sample(scene, sp, &bs, rays, &seen)) {
             float3 Le = emitted_radiance(&seen);
             if (any(Le != (float3)(0.0f))) {
                 float pdf_light = pdf_light_area(scene, sp, &seen, bs.wi);

@@ -107,20 +107,58 @@ inline float light_area_pdf_w(float pmf, float pdf_a, float d2, float cos_light)
     return pmf * pdf_a * d2 / cos_light;
 }
 
+/* ---- Choosing the light: one routine for both strategies, and its twin --------------------- */
+
+/* The light both strategies sample: the sky (select_sky) or an area light by the selection,
+ * from u.x and u_fine, with u.x remapped uniform for the point or direction on it. */
+typedef struct {
+    Light light;   /* the area light chosen, when `area` */
+    float pmf;     /* probability of the choice, the split with the sky included */
+    float2 u;      /* the rest of the sample, uniform again */
+    uint index;    /* the area light's index */
+    bool sky;      /* the sky light was chosen */
+    bool area;     /* an area light was chosen; neither: nothing can be sampled */
+} LightChoice;
+
+inline LightChoice choose_light(const SceneView* scene, const SurfacePoint* sp, float2 u,
+                                float u_fine) {
+    LightChoice c;
+    c.sky = c.area = false;
+    c.pmf = 0.0f;
+    c.index = 0u;
+    float u_select = u.x; /* a vector's element has no address in OpenCL C */
+    if (select_sky(scene, &u_select, &u_fine)) {
+        c.sky = true;
+        c.u = (float2)(u_select, u.y);
+        return c;
+    }
+    c.u = (float2)(u_select, u.y);
+    if (scene->lights.light_count == 0u) return c;
+    DiscreteSample choice = select_light(&scene->lights, sp->p, sp->n, u_select, u_fine);
+    if (!(choice.pmf > 0.0f)) return c; /* no light can reach sp (the tree) */
+    c.light = scene->lights.lights[choice.index];
+    c.pmf = choice.pmf * area_lights_pmf(scene);
+    c.u = (float2)(choice.u_remap, u.y);
+    c.index = choice.index;
+    c.area = true;
+    return c;
+}
+
+/* The twin: probability that choose_light at sp returns area light `index`. */
+inline float chosen_light_pmf(const SceneView* scene, const SurfacePoint* sp, uint index) {
+    return light_pmf(&scene->lights, sp->p, sp->n, index) * area_lights_pmf(scene);
+}
+
 /* ---- Area strategy: (light, point) with density pmf(light)/area ------------------------------ */
 
 inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint* sp, float2 u,
                                      float u_fine) {
-    float u_select = u.x; /* a vector's element has no address in OpenCL C */
-    if (select_sky(scene, &u_select, &u_fine))
-        return sample_light_sky(scene, sp, (float2)(u_select, u.y));
-    u.x = u_select;
+    LightChoice choice = choose_light(scene, sp, u, u_fine);
+    if (choice.sky) return sample_light_sky(scene, sp, choice.u);
     LightSample ls = no_light_sample();
-    if (scene->lights.light_count == 0u) return ls;
-    DiscreteSample choice = select_light(&scene->lights, sp->p, sp->n, u.x, u_fine);
-    if (!(choice.pmf > 0.0f)) return ls; /* no light can reach sp (the tree) */
-    Light light = scene->lights.lights[choice.index];
-    LightPoint lp = sample_light_point(&light, (float2)(choice.u_remap, u.y));
+    if (!choice.area) return ls;
+    const Light light = choice.light;
+    LightPoint lp = sample_light_point(&light, choice.u);
     float3 to_light = lp.p - sp->p;
     float d2 = dot(to_light, to_light);
     if (!(d2 > 0.0f)) return ls;
@@ -133,7 +171,7 @@ inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint*
     ls.y_error = lp.p_error;
     ls.n_toward = dot(n_light, wi) < 0.0f ? n_light : -n_light;
     ls.Le = light.Le.xyz;
-    ls.pmf = choice.pmf * area_lights_pmf(scene);
+    ls.pmf = choice.pmf;
     ls.pdf = lp.pdf_a;
     ls.d2 = d2;
     ls.cos_light = cos_y;
@@ -149,16 +187,12 @@ inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint*
  * area sampling, a choice fixed by (point, light), so the estimator stays unbiased. */
 inline LightSample sample_light_solid_angle(const SceneView* scene, const SurfacePoint* sp,
                                             float2 u_light, float u_fine) {
-    float u_select = u_light.x;
-    if (select_sky(scene, &u_select, &u_fine))
-        return sample_light_sky(scene, sp, (float2)(u_select, u_light.y));
-    u_light.x = u_select;
+    LightChoice choice = choose_light(scene, sp, u_light, u_fine);
+    if (choice.sky) return sample_light_sky(scene, sp, choice.u);
     LightSample ls = no_light_sample();
-    if (scene->lights.light_count == 0u) return ls;
-    DiscreteSample choice = select_light(&scene->lights, sp->p, sp->n, u_light.x, u_fine);
-    if (!(choice.pmf > 0.0f)) return ls; /* no light can reach sp (the tree) */
-    Light light = scene->lights.lights[choice.index];
-    float2 u = (float2)(choice.u_remap, u_light.y); /* the rest of the sample, for the direction */
+    if (!choice.area) return ls;
+    const Light light = choice.light;
+    float2 u = choice.u; /* the rest of the sample, for the direction */
     float3 n_light = light_normal(&light);
     float3 x = sp->p;
     /* A one-sided light seen from behind its plane shows only its back. */
@@ -204,7 +238,7 @@ inline LightSample sample_light_solid_angle(const SceneView* scene, const Surfac
     ls.y_error = y_error;
     ls.n_toward = dot(n_light, wi) < 0.0f ? n_light : -n_light;
     ls.Le = light.Le.xyz;
-    ls.pmf = choice.pmf * area_lights_pmf(scene);
+    ls.pmf = choice.pmf;
     ls.pdf = pdf_w;
     ls.d2 = dot(d, d);
     ls.cos_light = cos_y;
@@ -253,7 +287,7 @@ inline float pdf_light_area(const SceneView* scene, const SurfacePoint* sp,
     Light light = scene->lights.lights[index];
     float3 d = seen->p - sp->p;
     float cos_y = fabs(dot(seen->n, wi));
-    float pmf = light_pmf(&scene->lights, sp->p, sp->n, index) * area_lights_pmf(scene);
+    float pmf = chosen_light_pmf(scene, sp, index);
     return light_area_pdf_w(pmf, sample_triangle_uniform_pdf_a(light_area(&light)), dot(d, d),
                             cos_y);
 }
@@ -273,7 +307,7 @@ inline float pdf_light_solid_angle(const SceneView* scene, const SurfacePoint* s
     float3 a = normalize(light.p0.xyz - x), b = normalize(light.p1.xyz - x),
            c = normalize(light.p2.xyz - x);
     float omega = spherical_triangle_solid_angle(a, b, c);
-    float pmf = light_pmf(&scene->lights, sp->p, sp->n, index) * area_lights_pmf(scene);
+    float pmf = chosen_light_pmf(scene, sp, index);
     if (omega > MIN_SPHERICAL_SOLID_ANGLE && omega < MAX_SPHERICAL_SOLID_ANGLE) return pmf / omega;
     float3 d = seen->p - x;
     return pmf * pdf_area_to_solid_angle(sample_triangle_uniform_pdf_a(light_area(&light)),

@@ -128,7 +128,7 @@ inline DiscreteSample sample_light_tree(global const LightTreeNode* nodes, float
 }
 
 /* Probability that sample_light_tree at (p, n) returns the light whose trail is `trail` and
- * path length depth_plus_one − 1 (Light.Le.w, .p2.w): the same products along its path. */
+ * path length depth_plus_one − 1 (LightTreePath): the same products along its path. */
 inline float light_tree_pmf(global const LightTreeNode* nodes, uint trail, uint depth_plus_one,
                             float3 p, float3 n) {
     if (depth_plus_one == 0u) return 0.0f;

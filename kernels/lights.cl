@@ -6,20 +6,48 @@
 #include "light_tree.cl"
 #include "sampling.cl"
 
-/* Lights and their selection distributions: light_cdf (light_count + 1 entries) and alias
- * (light_count entries) both follow emitted power; the light tree (light_tree.cl) weighs power
- * by distance and orientation at the shading point. Zero-power lights are never selected. */
+/* The lights and the data of the light selection the render was built for (-D
+ * LIGHT_SELECT_UNIFORM, LIGHT_SELECT_POWER, LIGHT_SELECT_ALIAS or LIGHT_SELECT_TREE; the host's
+ * table of variants, host/render/variants.cpp). light_cdf (light_count + 1 entries) and alias
+ * (light_count entries) follow emitted power; the light tree (light_tree.cl) weighs power by
+ * distance and orientation at the shading point. Zero-power lights are never selected. */
+#if !defined(LIGHT_SELECT_UNIFORM) && !defined(LIGHT_SELECT_POWER) && \
+    !defined(LIGHT_SELECT_ALIAS) && !defined(LIGHT_SELECT_TREE)
+#error "no light selection: the host defines one LIGHT_SELECT_* (host/render/variants.cpp)"
+#endif
 typedef struct {
     global const Light* lights;
+#if defined(LIGHT_SELECT_POWER)
     global const float* light_cdf;
+#elif defined(LIGHT_SELECT_ALIAS)
     global const AliasEntry* alias;
+#elif defined(LIGHT_SELECT_TREE)
     global const LightTreeNode* tree;
+    global const LightTreePath* paths; /* one per light, after the tree's nodes */
+#endif
     uint light_count;
 } LightSet;
 
+/* The lights and the selection's view of its buffer (shared_types.h, RENDER_ARG_LIGHT_SELECTION:
+ * the tree's `tree_nodes` nodes, then the lights' paths). */
+inline LightSet light_set(global const Light* lights, uint light_count,
+                          global const uint* selection, uint tree_nodes) {
+    LightSet ls;
+    ls.lights = lights;
+    ls.light_count = light_count;
+#if defined(LIGHT_SELECT_POWER)
+    ls.light_cdf = (global const float*)selection;
+#elif defined(LIGHT_SELECT_ALIAS)
+    ls.alias = (global const AliasEntry*)selection;
+#elif defined(LIGHT_SELECT_TREE)
+    ls.tree = (global const LightTreeNode*)selection;
+    ls.paths = (global const LightTreePath*)(ls.tree + tree_nodes);
+#endif
+    return ls;
+}
+
 /* Selects a light for the shading point p with unit normal n (the side light must arrive
- * from) from u (-D LIGHT_SELECT_UNIFORM, LIGHT_SELECT_POWER, LIGHT_SELECT_ALIAS or
- * LIGHT_SELECT_TREE; only the tree reads p and n), refined below the 2^-24 grid by u_fine
+ * from) from u (only the tree reads p and n), refined below the 2^-24 grid by u_fine
  * (discrete.cl); the choice's u_remap is uniform again, for the point on the light.
  * light_count must be > 0. pmf 0 (the tree only): no light can reach p, nothing was chosen. */
 inline DiscreteSample select_light(const LightSet* ls, float3 p, float3 n, float u,
@@ -42,18 +70,18 @@ inline float light_pmf(const LightSet* ls, float3 p, float3 n, uint i) {
 #elif defined(LIGHT_SELECT_ALIAS)
     return discrete_alias_pmf(ls->alias, i);
 #elif defined(LIGHT_SELECT_TREE)
-    global const Light* light = ls->lights + i;
-    return light_tree_pmf(ls->tree, as_uint(light->Le.w), as_uint(light->p2.w), p, n);
+    LightTreePath path = ls->paths[i];
+    return light_tree_pmf(ls->tree, path.bits, path.length, p, n);
 #else
     return discrete_cdf_pmf(ls->light_cdf, i);
 #endif
 }
 
 inline bool light_double_sided(const Light* light) {
-    return (as_uint(light->p1.w) & MATERIAL_DOUBLE_SIDED) != 0u;
+    return (light->flags & MATERIAL_DOUBLE_SIDED) != 0u;
 }
 
-inline float light_area(const Light* light) { return light->p0.w; }
+inline float light_area(const Light* light) { return light->area; }
 
 /* Unit front-face normal (counter-clockwise winding). */
 inline float3 light_normal(const Light* light) {

@@ -17,14 +17,6 @@
 
 inline float max_component(float3 v) { return fmax(v.x, fmax(v.y, v.z)); }
 
-/* True when the memo holds the ray from sp along wi, bit for bit: the estimator traced the
- * continuation already (its BSDF or cosine direction from the same numbers). */
-inline bool memo_holds(const TraceMemo* memo, const SurfacePoint* sp, float3 wi) {
-    float3 o = spawn_origin(sp);
-    return memo->valid && all(as_uint3(memo->origin) == as_uint3(o)) &&
-           all(as_uint3(memo->wi) == as_uint3(wi));
-}
-
 /* What a path did, for the stats: surface vertices it reached, and whether roulette ended it. */
 typedef struct {
     uint rays;
@@ -35,17 +27,17 @@ typedef struct {
 /* Radiance arriving along camera ray r after at most max_depth reflections: L_e at the first hit,
  * plus at each vertex k < max_depth the throughput times the estimator's estimate of the light
  * reflected there directly (its own strategies; emitters that the continuation later finds are
- * not counted again). The continuation samples the BSDF with the vertex's DIM_DIRECTION numbers,
- * the ones the BSDF and MIS estimators use, so that their direction is also the path's (as
- * pbrt's path tracer shares it) and its ray is traced once (TraceMemo). A ray leaving the scene
- * sees black, or the sky for the ambient estimators (-D ESTIMATOR_USES_SKY) and the sky light
- * (DESIGN.md "Radiometric contract"). */
+ * not counted again). The continuation is the BSDF sample the estimator handed over
+ * (trace_bsdf_sample, api.cl: the BSDF and MIS estimators hand theirs, as pbrt's path tracer
+ * shares one sample), else the path's own draw with the vertex's DIM_DIRECTION numbers. A camera
+ * ray leaving the scene sees black or the sky light; with an ambient estimator, which has no
+ * path (-D MCRT_AMBIENT_ESTIMATOR), the sky (DESIGN.md "Radiometric contract"). */
 inline float3 path_radiance(const SceneView* scene, const Ray* r, SampleStream* stream,
                             uint max_depth, uint rr_depth, PathRecord* record) {
-    TraceMemo* memo = scene->memo; /* may be 0 (direct lighting keeps none) */
+    PathContinuation* given = scene->continuation; /* 0 for direct lighting */
     record->rays += 1u;
     Hit hit = bvh_closest_hit(scene->nodes, scene->packets, r, MAXFLOAT, MCRT_NO_HIT);
-#if defined(ESTIMATOR_USES_SKY)
+#if defined(MCRT_AMBIENT_ESTIMATOR)
     if (hit.lane == MCRT_NO_HIT) return scene->env.sky;
 #else
     if (hit.lane == MCRT_NO_HIT) return environment_radiance(scene);
@@ -57,12 +49,13 @@ inline float3 path_radiance(const SceneView* scene, const Ray* r, SampleStream* 
     for (uint k = 0u; k < max_depth;) {
         /* Direct light at vertex k, by the estimator's strategies. */
         stream->vertex = k;
-        if (memo) memo->valid = false;
+        if (given) given->given = false;
         L += beta * MCRT_ESTIMATE(scene, &sp, stream, &record->rays);
         if (++k == max_depth) break;
 
-        /* Continue by BSDF sampling. */
-        BsdfSample bs = bsdf_sample(&sp, sample_2d(stream, DIM_DIRECTION));
+        /* Continue by BSDF sampling: the estimator's sample, or the path's own. */
+        bool handed = given && given->given;
+        BsdfSample bs = handed ? given->bs : bsdf_sample(&sp, sample_2d(stream, DIM_DIRECTION));
         if (!(bs.pdf_w > 0.0f) || bs.cos_theta <= 0.0f) break;
         beta *= bs.f * (bs.cos_theta / bs.pdf_w);
         if (!(max_component(beta) > 0.0f)) break;
@@ -79,9 +72,9 @@ inline float3 path_radiance(const SceneView* scene, const Ray* r, SampleStream* 
         }
 
         SurfacePoint next;
-        if (memo && memo_holds(memo, &sp, bs.wi)) {
-            if (!memo->hit) break;
-            next = memo->seen;
+        if (handed) {
+            if (!given->found) break;
+            next = given->seen;
         } else if (!trace_from(scene, &sp, bs.wi, &record->rays, &next)) {
             break;
         }

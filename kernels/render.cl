@@ -12,8 +12,7 @@
  * packed PathRecord). Arguments in the order of RenderArgument. */
 kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                    global const TriangleInfo* triangle_info, global const Material* materials,
-                   global const Light* lights, global const float* light_cdf,
-                   global const AliasEntry* light_alias, global const LightTreeNode* light_tree,
+                   global const Light* lights, global const uint* light_selection,
                    global const CameraGpu* camera, global uint4* samples, RenderParams p) {
     size_t g = get_global_id(0);
     uint pixel = p.pixel_begin + (uint)(g / p.batch_samples);
@@ -33,17 +32,13 @@ kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* pa
     scene.packets = packets;
     scene.triangle_info = triangle_info;
     scene.materials = materials;
-    scene.lights.lights = lights;
-    scene.lights.light_cdf = light_cdf;
-    scene.lights.alias = light_alias;
-    scene.lights.tree = light_tree;
-    scene.lights.light_count = p.light_count;
+    scene.lights = light_set(lights, p.light_count, light_selection, p.light_tree_nodes);
     scene.env.sky = p.sky.xyz;
     scene.env.ao_distance = p.ao_distance;
     scene.env.sky_pmf = p.sky.w;
-    TraceMemo memo;
-    memo.valid = false;
-    scene.memo = p.max_depth > 1u ? &memo : 0; /* direct lighting has no continuation */
+    PathContinuation continuation;
+    continuation.given = false;
+    scene.continuation = p.max_depth > 1u ? &continuation : 0; /* direct lighting goes no further */
 
     float3 dir = camera_direction(camera, pixel % p.width, pixel / p.width,
                                   sample_2d(&stream, DIM_PIXEL_JITTER), p.width, p.height);

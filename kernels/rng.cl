@@ -217,7 +217,7 @@ inline float sampler_1d(const SampleStream* s, uint dim) {
     return uint_to_unit_float(reverse_bits(laine_karras_permutation(index, key.z)));
 }
 
-#else /* SAMPLER_INDEPENDENT */
+#elif defined(SAMPLER_INDEPENDENT)
 inline float sampler_1d(const SampleStream* s, uint dim) {
     return independent_1d(s->pixel, s->index, dim, s->seed);
 }
@@ -226,6 +226,8 @@ inline float sampler_1d(const SampleStream* s, uint dim) {
 inline float2 sampler_2d(const SampleStream* s, uint dim) {
     return independent_2d(s->pixel, s->index, dim, s->seed);
 }
+#else
+#error "no sampler: the host defines one SAMPLER_* (host/render/variants.cpp)"
 #endif
 
 /* ---- What estimators call ------------------------------------------------------------------- */

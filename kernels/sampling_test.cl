@@ -139,23 +139,22 @@ kernel void discrete_pmfs(uint method, global const float* cdf, global const Ali
     pmf[i] = method == 0u ? discrete_cdf_pmf(cdf, i) : discrete_alias_pmf(table, i);
 }
 
-/* Reads the light tree and the lights' trails (Light.Le.w, .p2.w); writes pmf[k · n + i] =
+/* Reads the light tree and the lights' paths (LightTreePath); writes pmf[k · n + i] =
  * light_tree_pmf of light i < n at shading point k < count (p[k].xyz, normal[k].xyz). */
-kernel void light_tree_pmfs(global const LightTreeNode* nodes, global const Light* lights, uint n,
+kernel void light_tree_pmfs(global const LightTreeNode* nodes, global const LightTreePath* paths, uint n,
                             uint count, global const float4* p, global const float4* normal,
                             global float* pmf) {
     uint g = (uint)get_global_id(0);
     if (g >= n * count) return;
     uint k = g / n, i = g % n;
-    pmf[g] = light_tree_pmf(nodes, as_uint(lights[i].Le.w), as_uint(lights[i].p2.w), p[k].xyz,
-                            normal[k].xyz);
+    pmf[g] = light_tree_pmf(nodes, paths[i].bits, paths[i].length, p[k].xyz, normal[k].xyz);
 }
 
-/* Reads the tree and the lights as light_tree_pmfs; writes out[j] = (index, pmf bits, u_remap
+/* Reads the tree and the paths as light_tree_pmfs; writes out[j] = (index, pmf bits, u_remap
  * bits, bits of the pmf twin light_tree_pmf of that index) for sample j < count · per_point at
  * shading point j / per_point. u: stratified, (j % per_point + 0.5) / per_point, when
  * stratified != 0, else hashed from (j, seed); u_fine hashed. */
-kernel void sample_light_tree_at(global const LightTreeNode* nodes, global const Light* lights,
+kernel void sample_light_tree_at(global const LightTreeNode* nodes, global const LightTreePath* paths,
                                  uint count, uint per_point, uint stratified, uint seed,
                                  global const float4* p, global const float4* normal,
                                  global uint4* out) {
@@ -167,9 +166,8 @@ kernel void sample_light_tree_at(global const LightTreeNode* nodes, global const
                                : uint_to_unit_float(h.x);
     float u_fine = uint_to_unit_float(h.y);
     DiscreteSample s = sample_light_tree(nodes, p[k].xyz, normal[k].xyz, u, u_fine);
-    float twin = s.pmf > 0.0f ? light_tree_pmf(nodes, as_uint(lights[s.index].Le.w),
-                                               as_uint(lights[s.index].p2.w), p[k].xyz,
-                                               normal[k].xyz)
+    float twin = s.pmf > 0.0f ? light_tree_pmf(nodes, paths[s.index].bits, paths[s.index].length,
+                                               p[k].xyz, normal[k].xyz)
                               : 0.0f;
     out[j] = (uint4)(s.index, as_uint(s.pmf), as_uint(s.u_remap), as_uint(twin));
 }

@@ -14,7 +14,7 @@ typedef struct {
                           is no light (light_sampling.cl) */
 } Environment;
 
-typedef struct TraceMemo TraceMemo;
+typedef struct PathContinuation PathContinuation; /* api.cl */
 
 typedef struct {
     global const Bvh4Node* nodes;
@@ -23,7 +23,8 @@ typedef struct {
     global const Material* materials;
     LightSet lights;
     Environment env;
-    TraceMemo* memo; /* the last ray of trace_from, for the path's continuation; 0: none kept */
+    PathContinuation* continuation; /* where trace_bsdf_sample hands the path its BSDF sample
+                                       (api.cl); 0 where no path goes on (direct lighting) */
 } SceneView;
 
 /* A surface point seen along a ray. */
@@ -85,20 +86,10 @@ inline SurfacePoint surface_point(const SceneView* scene, const Ray* r, const Hi
     return sp;
 }
 
-/* The last ray trace_from traced and what it found: when an estimator's BSDF or hemisphere
- * direction is also the path's continuation (path.cl), the path takes the surface from here
- * instead of tracing the same ray again. */
-struct TraceMemo {
-    float3 origin, wi;
-    SurfacePoint seen;
-    bool hit;
-    bool valid;
-};
-
 /* Radiance the surface emits toward the viewer: front face only unless double-sided. */
 inline float3 emitted_radiance(const SurfacePoint* sp) {
     bool emits = sp->front || (sp->material.flags & MATERIAL_DOUBLE_SIDED) != 0u;
-    return emits ? sp->material.Le.xyz : (float3)(0.0f);
+    return emits ? sp->material.emission.xyz : (float3)(0.0f);
 }
 
 /* Radiance that a ray leaving the scene sees: the sky when it is a light, else black. */
@@ -134,13 +125,6 @@ inline bool trace_from(const SceneView* scene, const SurfacePoint* sp, float3 wi
     Hit hit = bvh_closest_hit(scene->nodes, scene->packets, &r, MAXFLOAT, sp->lane);
     bool found = hit.lane != MCRT_NO_HIT;
     if (found) *seen = surface_point(scene, &r, &hit);
-    if (scene->memo) {
-        scene->memo->origin = r.org;
-        scene->memo->wi = wi;
-        scene->memo->hit = found;
-        if (found) scene->memo->seen = *seen;
-        scene->memo->valid = true;
-    }
     return found;
 }
 

@@ -126,16 +126,26 @@ typedef struct {
 
 #define MATERIAL_DOUBLE_SIDED 1u
 
-/* glTF 2.0 metallic-roughness material that may emit, 64 bytes (DESIGN.md "Radiometric
- * contract"). Lambertian when metallic = 0 and the dielectric's F90 = 0 (then F0 = 0 too). */
+/* Material.type: the reflection model of a surface. The kernels' build follows the scene
+ * (DESIGN.md "Radiometric contract": model no more than a scene needs): a scene whose every
+ * material is MATERIAL_LAMBERTIAN gets the course's Lambertian kernels; one with any other type
+ * the kernels of that model (-D MCRT_MATERIALS_GLTF), which evaluate a Lambertian material as
+ * the metallic-roughness BRDF with metallic 0 and F0 = F90 = 0, the same reflection. */
+#define MATERIAL_LAMBERTIAN 0u
+#define MATERIAL_METALLIC_ROUGHNESS 1u
+
+/* A surface's material, 64 bytes: glTF 2.0 metallic-roughness that may emit (DESIGN.md
+ * "Radiometric contract"). */
 typedef struct {
-    float4 albedo;   /* .xyz baseColorFactor, .w metallicFactor */
-    float4 Le;       /* .xyz emitted radiance, .w GGX α = max(roughness², MCRT_ALPHA_MIN) */
-    float4 specular; /* the dielectric's Schlick terms (KHR_materials_specular): .xyz F0 =
-                        min(0.04 specularColorFactor, 1) × specularFactor, .w F90 =
-                        specularFactor */
-    uint flags;      /* MATERIAL_DOUBLE_SIDED */
-    uint pad0, pad1, pad2;
+    float4 base_color; /* .xyz baseColorFactor, linear; .w its alpha */
+    float4 emission;   /* .xyz emitted radiance (emissiveFactor × emissive_strength); .w 0 */
+    float4 specular;   /* the dielectric's Schlick pair (KHR_materials_specular): .xyz F0 =
+                          min(0.04 specularColorFactor, 1) × specularFactor, .w F90 =
+                          specularFactor */
+    float metallic;    /* metallicFactor */
+    float alpha;       /* GGX α = max(roughness², MCRT_ALPHA_MIN) */
+    uint type;         /* MATERIAL_LAMBERTIAN or MATERIAL_METALLIC_ROUGHNESS */
+    uint flags;        /* MATERIAL_DOUBLE_SIDED */
 } Material;
 
 /* The least GGX α: roughness 0 (a mirror, a delta the estimators cannot sample) is read as
@@ -143,13 +153,14 @@ typedef struct {
  * 10⁻³ as smooth). */
 #define MCRT_ALPHA_MIN 1.0e-3f
 
-/* Emissive triangle for light sampling, 64 bytes. */
+/* Emissive triangle for light sampling, 80 bytes. What a light selection knows of the lights
+ * beside their power (its CDF, alias table or tree) lives in that selection's own buffer. */
 typedef struct {
-    float4 p0;  /* .w area */
-    float4 p1;  /* .w uint bits: flags (MATERIAL_DOUBLE_SIDED) */
-    float4 p2;  /* .w uint bits: 1 + the length of its path in the light tree; 0 not in it */
-    float4 Le;  /* .xyz emitted radiance; .w uint bits: the path, bit d set where it goes to the
-                   second child at depth d (selection pmfs live in the CDF, alias table, tree) */
+    float4 p0, p1, p2; /* vertices, counter-clockwise seen from the front; .w 0 */
+    float4 Le;         /* .xyz emitted radiance; .w 0 */
+    float area;
+    uint flags;        /* MATERIAL_DOUBLE_SIDED */
+    uint pad0, pad1;
 } Light;
 
 /* Node of the light tree (host/render/light_tree.h), 64 bytes: the bounds of the lights below it
@@ -173,9 +184,18 @@ typedef struct {
 #define LIGHT_NODE_TWO_SIDED 2u
 
 /* Longest root-to-leaf path of the light tree, in edges: a light's path is a bit trail of at
- * most this many bits (Light.Le.w), the builder switching to median splits before a path could
- * grow longer. */
+ * most this many bits (LightTreePath), the builder switching to median splits before a path
+ * could grow longer. */
 #define MCRT_LIGHT_TREE_MAX_DEPTH 32
+
+/* A light's path from the light tree's root to its leaf, 8 bytes, one per light after the
+ * tree's nodes in the tree's buffer: bit d of `bits` set where the path goes to the second
+ * child at depth d; `length` 1 + its number of edges, 0 for a light not in the tree (no power).
+ * The twins of the tree's choice (light_tree_pmf) walk it. */
+typedef struct {
+    uint bits;
+    uint length;
+} LightTreePath;
 
 /* One entry of an alias table (Walker 1977; Vose 1991), 16 bytes, on the 2^-24 grid of the
  * kernels' u (kernels/discrete.cl): bucket i keeps i when its coin, an integer in [0, 2^24), is
@@ -217,7 +237,8 @@ typedef struct {
                            replicate s % K as its sample s / K of spp / K (K divides 16 and spp) */
     uint max_depth;     /* reflections a path may have (--max-depth); 1: direct lighting */
     uint rr_depth;      /* Russian roulette before reflection k >= rr_depth (--rr-depth) */
-    uint pad0, pad1, pad2;
+    uint light_tree_nodes; /* the light tree's nodes at the head of the selection's buffer */
+    uint pad0, pad1;
 } RenderParams;
 
 /* What reduce_chunks writes for one run of samples: the samples of one pixel, one chunk and one
@@ -237,17 +258,21 @@ typedef struct {
 /* The render kernel's arguments in order (kernels/render.cl); the host binds them all in one
  * place (bind_render_arguments, host/render/device_worker.cpp). */
 enum RenderArgument {
-    RENDER_ARG_NODES,         /* global const Bvh4Node* */
-    RENDER_ARG_PACKETS,       /* global const TrianglePacket* */
-    RENDER_ARG_TRIANGLE_INFO, /* global const TriangleInfo*: per packet lane */
-    RENDER_ARG_MATERIALS,     /* global const Material* */
-    RENDER_ARG_LIGHTS,        /* global const Light* */
-    RENDER_ARG_LIGHT_CDF,     /* global const float*: light_count + 1 entries */
-    RENDER_ARG_LIGHT_ALIAS,   /* global const AliasEntry*: light_count entries */
-    RENDER_ARG_LIGHT_TREE,    /* global const LightTreeNode*: nodes[0] the root */
-    RENDER_ARG_CAMERA,        /* global const CameraGpu* */
-    RENDER_ARG_SAMPLES,       /* global float4*: out, one per work-item (radiance, rays) */
-    RENDER_ARG_PARAMS,        /* RenderParams, by value */
+    RENDER_ARG_NODES,           /* global const Bvh4Node* */
+    RENDER_ARG_PACKETS,         /* global const TrianglePacket* */
+    RENDER_ARG_TRIANGLE_INFO,   /* global const TriangleInfo*: per packet lane */
+    RENDER_ARG_MATERIALS,       /* global const Material* */
+    RENDER_ARG_LIGHTS,          /* global const Light* */
+    RENDER_ARG_LIGHT_SELECTION, /* global const uint*: the light selection's own data, built
+                                   only for it (kernels/lights.cl, light_set): power's CDF
+                                   (light_count + 1 floats), alias's table (light_count
+                                   AliasEntry), the tree's nodes (light_tree_nodes
+                                   LightTreeNode) followed by the lights' LightTreePath;
+                                   uniform reads none */
+    RENDER_ARG_CAMERA,          /* global const CameraGpu* */
+    RENDER_ARG_SAMPLES,         /* global uint4*: out, one per work-item (the radiance's bits,
+                                   the packed PathRecord) */
+    RENDER_ARG_PARAMS,          /* RenderParams, by value */
     RENDER_ARG_COUNT
 };
 
@@ -264,10 +289,12 @@ enum RenderArgument {
     TYPE(TriangleInfo, 8, 4) FIELD(TriangleInfo, material, 0) FIELD(TriangleInfo, light, 4)     \
     TYPE(Triangle, 48, 16) FIELD(Triangle, p0, 0) FIELD(Triangle, p1, 16)                       \
     FIELD(Triangle, p2, 32)                                                                     \
-    TYPE(Material, 64, 16) FIELD(Material, albedo, 0) FIELD(Material, Le, 16)                   \
-    FIELD(Material, specular, 32) FIELD(Material, flags, 48)                                    \
-    TYPE(Light, 64, 16) FIELD(Light, p0, 0) FIELD(Light, p1, 16) FIELD(Light, p2, 32)           \
-    FIELD(Light, Le, 48)                                                                        \
+    TYPE(Material, 64, 16) FIELD(Material, base_color, 0) FIELD(Material, emission, 16)         \
+    FIELD(Material, specular, 32) FIELD(Material, metallic, 48) FIELD(Material, alpha, 52)      \
+    FIELD(Material, type, 56) FIELD(Material, flags, 60)                                        \
+    TYPE(Light, 80, 16) FIELD(Light, p0, 0) FIELD(Light, p1, 16) FIELD(Light, p2, 32)           \
+    FIELD(Light, Le, 48) FIELD(Light, area, 64) FIELD(Light, flags, 68)                         \
+    TYPE(LightTreePath, 8, 4) FIELD(LightTreePath, bits, 0) FIELD(LightTreePath, length, 4)     \
     TYPE(AliasEntry, 16, 4) FIELD(AliasEntry, threshold, 0) FIELD(AliasEntry, alias, 4)         \
     FIELD(AliasEntry, pmf, 8)                                                                   \
     TYPE(LightTreeNode, 64, 16) FIELD(LightTreeNode, lo, 0) FIELD(LightTreeNode, hi, 16)       \
@@ -282,7 +309,7 @@ enum RenderArgument {
     FIELD(RenderParams, pixel_begin, 40) FIELD(RenderParams, pixel_end, 44)                     \
     FIELD(RenderParams, sample_begin, 48) FIELD(RenderParams, batch_samples, 52)                 \
     FIELD(RenderParams, replicates, 56) FIELD(RenderParams, max_depth, 60)                      \
-    FIELD(RenderParams, rr_depth, 64)                                                           \
+    FIELD(RenderParams, rr_depth, 64) FIELD(RenderParams, light_tree_nodes, 68)                 \
     TYPE(ChunkSums, 64, 16) FIELD(ChunkSums, shift, 0) FIELD(ChunkSums, sum, 16)                \
     FIELD(ChunkSums, sum_sq, 32) FIELD(ChunkSums, exponent, 48)
 

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "render/renderer.h"
+#include "render/variants.h"
 #include "cl/binary_cache.h"
 #include "cl/cl_error.h"
 #include "cl/program.h"
@@ -120,6 +122,13 @@ void write_bytes(const fs::path& path, const std::vector<char>& bytes) {
     out.write(bytes.data(), std::streamsize(bytes.size()));
 }
 
+}  // namespace
+
+namespace {
+// The render program's options for the default settings.
+std::string default_render_options() {
+    return mcrt::variant_program_options(mcrt::resolve_variants(mcrt::RenderSettings{}), false);
+}
 }  // namespace
 
 TEST_CASE("the cache directory follows MCRT_CACHE_DIR, XDG_CACHE_HOME, then HOME", "[cache]") {
@@ -387,13 +396,13 @@ TEST_CASE("cached_program stores the render kernel in the binary cache", "[cache
     setenv("POCL_KERNEL_CACHE", "0", 1);
     DeviceContext device = first_device();
     TempCache cache;
-    cl::Program program = cached_program(device, "render.cl", "-D MCRT_ESTIMATE=estimate_light_area");
+    cl::Program program = cached_program(device, "render.cl", default_render_options());
     unsetenv("POCL_KERNEL_CACHE");
     CHECK(program());
     CHECK(cache.files().size() == 1);
     BuildReport report;
     // cached_program adds the device's own options (device_program_options) to the key.
     build(device, kernel_source("render.cl"),
-          "-D MCRT_ESTIMATE=estimate_light_area" + device_program_options(device.info), report);
+          default_render_options() + device_program_options(device.info), report);
     CHECK(report.cache_hit);
 }

@@ -14,6 +14,15 @@
 using namespace mcrt;
 using mcrt::test::first_device;
 
+namespace {
+// A render program's options: one estimator, light selection, sampler and MIS heuristic each
+// (the kernels refuse to build without).
+std::string default_render_options() {
+    return "-D MCRT_ESTIMATE=estimate_light_area -D LIGHT_SELECT_POWER -D SAMPLER_INDEPENDENT "
+           "-D MIS_BALANCE";
+}
+}  // namespace
+
 TEST_CASE("every device is listed with its index and properties", "[cl]") {
     std::vector<DeviceInfo> devices = enumerate_devices([](const std::string& w) { WARN(w); });
     REQUIRE(!devices.empty());
@@ -100,7 +109,7 @@ TEST_CASE("the device sees every shared struct with the host's size, alignment a
     REQUIRE(want.size() > 40);
 
     DeviceContext device = first_device();
-    cl::Program program = cached_program(device, "render.cl", "-D MCRT_ESTIMATE=estimate_light_area");
+    cl::Program program = cached_program(device, "render.cl", default_render_options());
     cl::Kernel kernel = make_kernel(program, "shared_type_layout");
     cl_int status;
     cl::Buffer layout(device.context, CL_MEM_WRITE_ONLY, want.size() * sizeof(cl_uint), nullptr, &status);

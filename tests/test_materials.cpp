@@ -17,6 +17,7 @@
 #include "cl/program.h"
 #include "device_support.h"
 #include "kernel_program.h"
+#include "render/plan.h"
 #include "independent_renders.h"
 #include "process_support.h"
 #include "render/render_program.h"
@@ -85,7 +86,7 @@ dvec3 reference_brdf(const TestMaterial& m, dvec3 v, dvec3 l) {
 using Device = KernelProgram;
 
 Device& device() {
-    static Device d("bsdf_test.cl", "-D MCRT_MATERIALS_GLTF");
+    static Device d("bsdf_test.cl", "-D MCRT_MATERIALS_GLTF -D LIGHT_SELECT_POWER -D SAMPLER_INDEPENDENT");
     return d;
 }
 
@@ -106,7 +107,7 @@ Sampled sample(const TestMaterial& m, dvec3 wo, size_t n, cl_uint seed) {
     Device& d = device();
     gpu::Material g = m.packed();
     cl::Buffer out = d.output<cl_float4>(n), f = d.output<cl_float4>(n);
-    d.run("bsdf_samples", n, f4(g.albedo), f4(g.Le), f4(g.specular), f4(wo), cl_uint(n), seed, out,
+    d.run("bsdf_samples", n, g, f4(wo), cl_uint(n), seed, out,
           f);
     return {d.read<cl_float4>(out, n), d.read<cl_float4>(f, n)};
 }
@@ -116,7 +117,7 @@ void evaluate(const TestMaterial& m, dvec3 wo, const std::vector<cl_float4>& wi,
     Device& d = device();
     gpu::Material g = m.packed();
     cl::Buffer in = d.buffer(wi), p = d.output<float>(wi.size()), fb = d.output<cl_float4>(wi.size());
-    d.run("bsdf_evaluate", wi.size(), f4(g.albedo), f4(g.Le), f4(g.specular), f4(wo),
+    d.run("bsdf_evaluate", wi.size(), g, f4(wo),
           cl_uint(wi.size()), in, p, fb);
     if (pdf) *pdf = d.read<float>(p, wi.size());
     if (f) *f = d.read<cl_float4>(fb, wi.size());
@@ -359,7 +360,7 @@ TEST_CASE("the glTF BRDF is reciprocal", "[materials]") {
         Device& d = device();
         gpu::Material g = mat.packed();
         cl::Buffer in = d.buffer(pairs), out = d.output<cl_float4>(pairs.size());
-        d.run("bsdf_swapped", pairs.size() / 2, f4(g.albedo), f4(g.Le), f4(g.specular),
+        d.run("bsdf_swapped", pairs.size() / 2, g,
               cl_uint(pairs.size() / 2), in, out);
         std::vector<cl_float4> f = d.read<cl_float4>(out, pairs.size());
         double worst = 0;
@@ -544,14 +545,14 @@ TEST_CASE("Lambertian scenes build without the microfacet code and render bitwis
     const Camera camera = as_exported.cameras.front();
     GpuSceneData glossy = gpu_scene_for(as_exported, camera, settings);
     CHECK(glossy.microfacet);
-    CHECK(render_program_options(settings, glossy.microfacet).find("MCRT_MATERIALS_GLTF") !=
+    CHECK(make_render_plan(settings, glossy).program_options.find("MCRT_MATERIALS_GLTF") !=
           std::string::npos);
 
     Scene lambert = as_exported;
     make_lambertian(lambert.materials);
     GpuSceneData flat = gpu_scene_for(lambert, camera, settings);
     CHECK_FALSE(flat.microfacet);
-    CHECK(render_program_options(settings, flat.microfacet).find("MCRT_MATERIALS_GLTF") ==
+    CHECK(make_render_plan(settings, flat).program_options.find("MCRT_MATERIALS_GLTF") ==
           std::string::npos);
 
     DeviceContext device = first_device();

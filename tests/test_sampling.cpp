@@ -40,7 +40,7 @@ enum WarpKind : cl_uint { kUniform = 0, kCosine = 1, kSphericalTriangle = 2, kFi
 using Device = KernelProgram;
 
 Device& device() {
-    static Device d("sampling_test.cl", "");
+    static Device d("sampling_test.cl", "-D SAMPLER_INDEPENDENT");
     return d;
 }
 
@@ -875,8 +875,10 @@ TreeLights tree_lights(int n, uint32_t seed, int zero_power = 0) {
         dvec3 p0 = c, p1 = c + size * a, p2 = c + size * b;  // counter-clockwise about normal
         gpu::Light l{};
         bool two_sided = unit(rng) < 0.25;
-        l.p0 = g4(p0, float(0.5 * size * size));
-        l.p1 = g4(p1, gpu::as_float(two_sided ? MATERIAL_DOUBLE_SIDED : 0u));
+        l.p0 = g4(p0);
+        l.p1 = g4(p1);
+        l.area = float(0.5 * size * size);
+        l.flags = two_sided ? MATERIAL_DOUBLE_SIDED : 0u;
         l.p2 = g4(p2);
         l.Le = g4(dvec3(1.0));
         t.lights.push_back(l);
@@ -914,11 +916,11 @@ TEST_CASE("light tree: every light in one leaf, bounds hold their children", "[s
         size_t max_depth = 0;
         for (size_t i = 0; i < t.lights.size(); ++i) {
             if (t.powers[i] == 0) {
-                CHECK(tree.depth_plus_one[i] == 0);
+                CHECK(tree.paths[i].length == 0);
                 continue;
             }
-            REQUIRE(tree.depth_plus_one[i] >= 1);
-            const size_t depth = tree.depth_plus_one[i] - 1;
+            REQUIRE(tree.paths[i].length >= 1);
+            const size_t depth = tree.paths[i].length - 1;
             max_depth = std::max(max_depth, depth);
             REQUIRE(depth <= MCRT_LIGHT_TREE_MAX_DEPTH);
             // Down the trail: every node on it bounds the light (box, normal cone, power).
@@ -942,7 +944,7 @@ TEST_CASE("light tree: every light in one leaf, bounds hold their children", "[s
                     leaf_of[i] += 1;
                 } else {
                     REQUIRE((x.flags & LIGHT_NODE_LEAF) == 0);
-                    node = x.child + ((tree.trail[i] >> d) & 1u);
+                    node = x.child + ((tree.paths[i].bits >> d) & 1u);
                 }
             }
         }
@@ -960,15 +962,14 @@ TEST_CASE("light tree: every light in one leaf, bounds hold their children", "[s
 struct TreeOnDevice {
     TreeLights t;
     cl_uint n;
-    cl::Buffer nodes, lights, p, normal;
+    cl::Buffer nodes, paths, p, normal;
     std::vector<cl_float4> points, normals;
     TreeOnDevice(Device& d, const TreeCase& c, size_t point_count) : t(tree_lights(c.n, 11u + uint32_t(c.n), c.zero_power)) {
         LightTree tree = build_light_tree(t.lights, t.powers);
-        store_light_trails(tree, t.lights);
         n = cl_uint(t.lights.size());
         tree_points(point_count, 3u + uint32_t(c.n), points, normals);
         nodes = d.buffer(tree.nodes);
-        lights = d.buffer(t.lights);
+        paths = d.buffer(tree.paths);
         p = d.buffer(points);
         normal = d.buffer(normals);
     }
@@ -986,11 +987,11 @@ TEST_CASE("light tree: pmfs sum to 1 at every point, the sampler reports the twi
         TreeOnDevice tree(d, c, kPoints);
         INFO("lights " << tree.n);
         cl::Buffer pmf = d.output<float>(tree.n * kPoints);
-        d.run("light_tree_pmfs", tree.n * kPoints, tree.nodes, tree.lights, tree.n, cl_uint(kPoints),
+        d.run("light_tree_pmfs", tree.n * kPoints, tree.nodes, tree.paths, tree.n, cl_uint(kPoints),
               tree.p, tree.normal, pmf);
         std::vector<float> pmfs = d.read<float>(pmf, tree.n * kPoints);
         cl::Buffer out = d.output<cl_uint4>(kPoints * kPerPoint);
-        d.run("sample_light_tree_at", kPoints * kPerPoint, tree.nodes, tree.lights,
+        d.run("sample_light_tree_at", kPoints * kPerPoint, tree.nodes, tree.paths,
               cl_uint(kPoints), cl_uint(kPerPoint), 0u, 5u, tree.p, tree.normal, out);
         std::vector<cl_uint4> s = d.read<cl_uint4>(out, kPoints * kPerPoint);
         size_t reachable = 0, wrong_twin = 0, zero_chosen = 0, out_of_range = 0, none_chosen = 0;
@@ -1006,7 +1007,7 @@ TEST_CASE("light tree: pmfs sum to 1 at every point, the sampler reports the twi
                     const gpu::Light& l = tree.t.lights[i];
                     dvec3 v[3] = {d3(l.p0), d3(l.p1), d3(l.p2)};
                     dvec3 ln = glm::normalize(glm::cross(v[1] - v[0], v[2] - v[0]));
-                    bool two_sided = (gpu::as_uint(l.p1.w) & MATERIAL_DOUBLE_SIDED) != 0;
+                    bool two_sided = (l.flags & MATERIAL_DOUBLE_SIDED) != 0;
                     bool above = false;
                     for (const dvec3& y : v) above = above || glm::dot(n, y - p) > 1e-6;
                     bool facing = two_sided || glm::dot(ln, p - v[0]) > -1e-6;
@@ -1048,7 +1049,7 @@ TEST_CASE("light tree: selection frequencies match the pmf (chi2), stratified u 
         if (c.n < 2) continue;
         TreeOnDevice tree(d, c, 8);
         cl::Buffer pmf = d.output<float>(tree.n * 8);
-        d.run("light_tree_pmfs", tree.n * 8, tree.nodes, tree.lights, tree.n, cl_uint(8), tree.p,
+        d.run("light_tree_pmfs", tree.n * 8, tree.nodes, tree.paths, tree.n, cl_uint(8), tree.p,
               tree.normal, pmf);
         std::vector<float> pmfs = d.read<float>(pmf, tree.n * 8);
         // The first point that some light reaches.
@@ -1062,7 +1063,7 @@ TEST_CASE("light tree: selection frequencies match the pmf (chi2), stratified u 
         cl::Buffer out = d.output<cl_uint4>(kSamples);
         const std::string name = "light tree " + std::to_string(tree.n);
         for (cl_uint stratified : {0u, 1u}) {
-            d.run("sample_light_tree_at", kSamples, tree.nodes, tree.lights, 1u, cl_uint(kSamples),
+            d.run("sample_light_tree_at", kSamples, tree.nodes, tree.paths, 1u, cl_uint(kSamples),
                   stratified, 9u, p1, n1, out);
             std::vector<cl_uint4> s = d.read<cl_uint4>(out, kSamples);
             std::vector<double> observed(tree.n, 0.0), expected(tree.n);

@@ -16,7 +16,7 @@ float3 estimate(const SceneView* scene, const SurfacePoint* sp, const SampleStre
 
     SurfacePoint seen;
     /* A direction that leaves the scene sees the sky light (black without --sky). */
-    float3 Le = trace_from(scene, sp, bs.wi, rays, &seen) ? emitted_radiance(&seen)
+    float3 Le = trace_bsdf_sample(scene, sp, &bs, rays, &seen) ? emitted_radiance(&seen)
                                                           : environment_radiance(scene);
     return bs.f * Le * (bs.cos_theta / bs.pdf_w);
 }

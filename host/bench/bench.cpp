@@ -15,11 +15,12 @@
 #include "bvh/bvh.h"
 #include "cl/cl_error.h"
 #include "cl/device.h"
-#include "cli/device_select.h"
+#include "cl/device_select.h"
 #include "render/memory_estimate.h"
 #include "cl/program.h"
 #include "common/error.h"
 #include "render/gpu_scene.h"
+#include "render/plan.h"
 #include "scene/gltf_import.h"
 
 namespace mcrt {
@@ -188,9 +189,7 @@ int run_bench(const BenchOptions& o, const std::function<void(const std::string&
 
     Scene scene = load_gltf(o.scene, warn);
     if (scene.triangle_count() == 0) warn(o.scene + ": the scene has no triangles");
-    Camera camera = o.camera                ? *o.camera
-                    : scene.cameras.empty() ? bench_camera(scene)
-                                            : scene.cameras.front();
+    Camera camera = choose_camera(scene, CameraChoice{-1, o.camera});
     BenchFrame frame = bench_frame(scene);
 
     Bvh bvh = build_bvh(scene, o.bvh);

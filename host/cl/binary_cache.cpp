@@ -1,6 +1,8 @@
 // Compiled program binaries on disk, keyed by device, driver, source and options.
 #include "cl/binary_cache.h"
 
+#include "common/environment.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -106,7 +108,7 @@ void append_field(std::string& out, const char* name, const std::string& value) 
 }
 
 bool cache_disabled() {
-    const char* off = std::getenv("MCRT_NO_KERNEL_CACHE");
+    const char* off = environment(kEnvNoKernelCache);
     return off && *off && std::strcmp(off, "0") != 0;
 }
 
@@ -223,10 +225,10 @@ BinaryCacheKey binary_cache_key(const DeviceInfo& device, const std::string& sou
 
 std::string binary_cache_directory() {
     if (cache_disabled()) return {};
-    if (const char* dir = std::getenv("MCRT_CACHE_DIR"); dir && *dir) return dir;
-    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
+    if (const char* dir = environment(kEnvCacheDir); dir && *dir) return dir;
+    if (const char* xdg = environment(kEnvXdgCacheHome); xdg && *xdg)
         return std::string(xdg) + "/mcrt/kernels";
-    if (const char* home = std::getenv("HOME"); home && *home)
+    if (const char* home = environment(kEnvHome); home && *home)
         return std::string(home) + "/.cache/mcrt/kernels";
     return {};
 }

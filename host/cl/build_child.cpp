@@ -1,5 +1,7 @@
 #include "cl/build_child.h"
 
+#include "common/environment.h"
+
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/prctl.h>
@@ -80,7 +82,7 @@ void set_build_stop_flag(const volatile std::sig_atomic_t* flag) { g_stop_flag =
 
 const std::string& build_child_executable() {
     static const std::string path = [] {
-        if (const char* forced = std::getenv("MCRT_BUILD_CHILD"); forced)
+        if (const char* forced = environment(kEnvBuildChild); forced)
             return std::string(forced);  // a path, or "" for builds in this process
         std::error_code ec;
         fs::path self = fs::read_symlink("/proc/self/exe", ec);

@@ -1,5 +1,7 @@
 #include "cl/no_device.h"
 
+#include "common/environment.h"
+
 #include <unistd.h>
 
 #include <cstdlib>
@@ -14,10 +16,10 @@ namespace {
 
 // PoCL's cache directory: POCL_CACHE_DIR, else $XDG_CACHE_HOME/pocl, else $HOME/.cache/pocl.
 std::string pocl_cache_directory() {
-    if (const char* dir = std::getenv("POCL_CACHE_DIR"); dir && *dir) return dir;
-    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
+    if (const char* dir = environment(kEnvPoclCacheDir); dir && *dir) return dir;
+    if (const char* xdg = environment(kEnvXdgCacheHome); xdg && *xdg)
         return std::string(xdg) + "/pocl";
-    if (const char* home = std::getenv("HOME"); home && *home)
+    if (const char* home = environment(kEnvHome); home && *home)
         return std::string(home) + "/.cache/pocl";
     return {};
 }

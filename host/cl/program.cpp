@@ -1,5 +1,7 @@
 #include "cl/program.h"
 
+#include "common/environment.h"
+
 #include <cstdlib>
 #include <fstream>
 #include <map>
@@ -20,7 +22,7 @@ constexpr int kDriverCachesStoreAfterMisses = 3;
 const std::map<std::string, std::string>& embedded_kernel_files();  // generated at build time
 
 static std::string read_kernel_file(const std::string& name) {
-    if (const char* dir = std::getenv("MCRT_KERNEL_DIR"); dir && *dir) {
+    if (const char* dir = environment(kEnvKernelDir); dir && *dir) {
         std::ifstream in(std::string(dir) + "/" + name, std::ios::binary);
         if (!in) throw RuntimeError("kernel file not found: " + std::string(dir) + "/" + name);
         std::ostringstream text;
@@ -129,7 +131,7 @@ cl::Program cached_program(const DeviceContext& device, const std::string& file,
     // 16). Asking PoCL for the binary costs a code generation (about 1 s per variant), so there
     // the binary is stored at a variant's third build only: one built once or twice (most of a
     // test suite's) never pays for it.
-    const char* pocl_cache = std::getenv("POCL_KERNEL_CACHE");
+    const char* pocl_cache = environment(kEnvPoclKernelCache);
     bool driver_caches = device.info.platform_name.find("Portable Computing Language") !=
                              std::string::npos &&
                          !(pocl_cache && std::string(pocl_cache) == "0");

@@ -8,7 +8,7 @@
 #include <iostream>
 
 #include "cl/cl_error.h"
-#include "cli/device_select.h"
+#include "cl/device_select.h"
 #include "cli/messages.h"
 #include "cl/program.h"
 #include "common/atomic_file.h"
@@ -114,7 +114,7 @@ std::vector<IntegrateRow> integrate_cosine_hemisphere(const DeviceContext& devic
                                                       const IntegrateOptions& o) {
     check_options(o);
     cl::Program program = build_program(device.context, device.info.device,
-                                        kernel_source("integrate.cl"), "-cl-std=CL1.2");
+                                        kernel_source("integrate.cl"), "-cl-std=CL1.2 -D SAMPLER_INDEPENDENT");
     const uint32_t repeats = uint32_t(o.repeats);
     const int64_t largest = *std::max_element(o.n.begin(), o.n.end());
     cl::Buffer samples = device_buffer(

@@ -11,7 +11,7 @@
 #include <sstream>
 
 #include "bvh/bvh.h"
-#include "cli/device_select.h"
+#include "cl/device_select.h"
 #include "cli/messages.h"
 #include "cli/progress.h"
 #include "cli/stats_json.h"
@@ -90,50 +90,40 @@ std::string help_list(const char* what, const Table& table) {
 
 }  // namespace
 
-RenderSettings render_settings(const RenderOptions& o, const std::string* estimator_source) {
-    RenderSettings settings;
+RenderRequest render_request(const RenderOptions& o) {
+    RenderRequest r;
+    r.scene = o.scene;
+    RenderSettings& settings = r.settings;
     settings.width = o.width;
     settings.height = o.height;
     settings.spp = o.spp;
     settings.estimator = o.estimator;
     if (!o.estimator_file.empty()) {
         settings.estimator_file = o.estimator_file;
-        settings.estimator_source =
-            estimator_source ? *estimator_source : read_estimator_file(o.estimator_file);
+        // Rank 0 reads the file; the other ranks get its text from rank 0 (serve_render).
+        if (job_rank() == 0) settings.estimator_source = read_estimator_file(o.estimator_file);
     }
     settings.light_select = o.light_select;
     settings.sampler = o.sampler;
     settings.mis_heuristic = o.mis_heuristic;
     settings.materials = o.materials;
-    // The ambient estimators' sky is 1 unless given; for the others --sky makes it a light.
-    const unsigned uses =
-        o.estimator_file.empty() ? estimator_variant(o.estimator).uses : kUserEstimatorUses;
-    settings.sky = o.sky.empty() ? glm::vec3(uses & kUsesSky ? 1.0f : 0.0f) : parse_sky(o.sky);
-    settings.sky_light = (uses & kUsesSkyLight) && !o.sky.empty() &&
-                         (settings.sky.r > 0 || settings.sky.g > 0 || settings.sky.b > 0);
+    if (!o.sky.empty()) r.sky = parse_sky(o.sky);
     settings.ao_distance = o.ao_distance;
     settings.max_depth = o.max_depth;
     settings.rr_depth = o.rr_depth;
     settings.seed = o.seed;
     settings.batch = o.batch;
-    settings.replicates = resolve_replicates(o.replicates, settings);
-    render_program_options(settings);  // rejects what is not supported before any work
-    return settings;
+    settings.replicates = o.replicates;
+    r.camera.index = o.camera;
+    r.camera.look = look_at_camera(o.look);  // a bad --look-from ... is refused here
+    return r;
 }
 
-void apply_materials_option(Scene& scene, const RenderSettings& settings) {
-    if (settings.materials == "lambert") make_lambertian(scene.materials);
-}
-
-Camera render_camera(const Scene& scene, const RenderOptions& o) {
-    if (std::optional<Camera> look = look_at_camera(o.look)) return *look;
-    if (o.camera >= 0) {
-        if (size_t(o.camera) >= scene.cameras.size())
-            throw InputError("--camera " + std::to_string(o.camera) + ": " + o.scene + " has " +
-                             std::to_string(scene.cameras.size()) + " perspective camera(s)");
-        return scene.cameras[size_t(o.camera)];
-    }
-    return scene.cameras.empty() ? bench_camera(scene) : scene.cameras.front();
+InputError flag_error(const SettingError& e) {
+    std::string flag = "--" + e.setting;
+    for (char& c : flag)
+        if (c == '_') c = '-';
+    return InputError(flag + " " + e.detail);
 }
 
 CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
@@ -228,22 +218,18 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     std::vector<std::string> inputs = {o.scene};
     if (!o.estimator_file.empty()) inputs.push_back(o.estimator_file);
     check_outputs(outputs, inputs);
-    RenderSettings settings = render_settings(o);
-    look_at_camera(o.look);  // a bad --look-from ... is refused before the scene loads
+    const RenderRequest request = render_request(o);
 
     FileBundle files;  // what the other ranks load the scene from
-    Scene scene = load_gltf(o.scene, print_warning, &inputs, job ? &files : nullptr);
-    apply_materials_option(scene, settings);
+    SceneSource source;
+    source.files_read = &inputs;
+    source.record = job ? &files : nullptr;
+    const PlannedRender planned = plan_render(request, source, print_warning);
+    const RenderPlan& plan = planned.plan;
+    const RenderSettings& settings = plan.settings;
     check_outputs(outputs, inputs);  // its buffers too
     check_host_memory("a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " render",
                       render_host_bytes(o.width, o.height, settings.replicates));
-    if (scene.triangle_count() == 0) print_warning(o.scene + ": the scene has no triangles");
-    unsigned uses =
-        o.estimator_file.empty() ? estimator_variant(o.estimator).uses : kUserEstimatorUses;
-    if ((uses & kUsesLights) && !settings.sky_light && collect_emitters(scene).empty())
-        print_warning(o.scene + ": no emissive triangles: direct lighting is black" +
-                      (uses & kUsesSkyLight ? " (--sky R,G,B adds a sky light)" : ""));
-    Camera camera = render_camera(scene, o);
     if (job) {
         job->share_inputs(files, settings.estimator_source);
         files.clear();
@@ -257,10 +243,6 @@ int render_here(const RenderOptions& o, RenderJob* job) {
         device_list.push_back(contexts.back().get());
     }
 
-    Bvh bvh = build_bvh(scene);
-    GpuSceneData gpu_scene = make_gpu_scene(scene, bvh, camera, o.width, o.height,
-                                            light_select_uses_tree(settings.light_select));
-
     RenderControl control;
     control.time_limit = o.time_limit;
     control.interrupted = &g_interrupted;
@@ -269,7 +251,7 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     const double seconds_to_render =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     RenderResult result = render(
-        device_list, gpu_scene, settings,
+        device_list, planned.scene.gpu, plan,
         [&](uint32_t done, uint32_t total, const std::vector<DeviceReport>& d) {
             bar.update(done, total, d);
         },
@@ -303,8 +285,8 @@ int render_here(const RenderOptions& o, RenderJob* job) {
 
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!o.stats.empty()) {
-        nlohmann::json j = render_stats_json(
-            {o, settings, scene, bvh, gpu_scene, result, total, seconds_to_render});
+        nlohmann::json j =
+            render_stats_json({o, planned, result, total, seconds_to_render});
         if (job) j["ranks"] = job->ranks_json(result.devices);
         write_atomically(o.stats, [&](const std::string& tmp) {
             std::ofstream out(tmp);
@@ -322,17 +304,18 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     return 0;
 }
 
-}  // namespace
-
-int run_render(const RenderOptions& o) {
+int render_in_job(const RenderOptions& o) {
     if (job_size() == 1) return render_here(o, nullptr);
-    if (job_rank() > 0) return serve_render(o);
+    if (job_rank() > 0) return serve_render(render_request(o), o.devices);
     // Every rank exits with rank 0's status; its error line is printed by run_cli alone.
     RenderJob job;
     try {
         const int status = render_here(o, &job);
         job.finish(status);
         return status;
+    } catch (const SettingError& e) {
+        job.finish(2, flag_error(e).what());
+        throw;
     } catch (const InputError& e) {
         job.finish(2, e.what());
         throw;
@@ -342,6 +325,16 @@ int run_render(const RenderOptions& o) {
     } catch (...) {
         job.finish(1);
         throw;
+    }
+}
+
+}  // namespace
+
+int run_render(const RenderOptions& o) {
+    try {
+        return render_in_job(o);
+    } catch (const SettingError& e) {
+        throw flag_error(e);  // the settings' words, as the command line's flags
     }
 }
 

@@ -7,7 +7,8 @@
 #include <vector>
 
 #include "cli/camera_options.h"
-#include "render/renderer.h"
+#include "common/error.h"
+#include "render/plan.h"
 #include "scene/scene.h"
 
 namespace mcrt {
@@ -41,12 +42,11 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& o);
 // (host/mpi/job.h).
 int run_render(const RenderOptions& o);
 
-// What every rank of an MPI render derives alike from the options: the settings (given
-// `estimator_source`, that is the text of --estimator-file, not read again) and the camera.
-RenderSettings render_settings(const RenderOptions& o,
-                               const std::string* estimator_source = nullptr);
-Camera render_camera(const Scene& scene, const RenderOptions& o);
-// The scene's materials as --materials reads them (lambert: every surface baseColor/π).
-void apply_materials_option(Scene& scene, const RenderSettings& settings);
+// The request the options make (render/plan.h), as every rank of an MPI render reads it alike;
+// the estimator file's text is read on rank 0 alone (the others get it from rank 0).
+RenderRequest render_request(const RenderOptions& o);
+
+// A setting the render library refused (SettingError), said with the command line's flag.
+InputError flag_error(const SettingError& e);
 
 }  // namespace mcrt

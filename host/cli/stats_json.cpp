@@ -9,10 +9,11 @@ namespace mcrt {
 nlohmann::json render_stats_json(const RenderStatsInput& in) {
     const RenderOptions& o = in.options;
     const RenderResult& result = in.result;
-    const Bvh& bvh = in.bvh;
+    const RenderSettings& settings = in.planned.plan.settings;
+    const Bvh& bvh = in.planned.scene.bvh;
+    const GpuSceneData& gpu_scene = in.planned.scene.gpu;
     uint64_t samples = uint64_t(o.width) * o.height * result.spp;
-    unsigned uses =
-        o.estimator_file.empty() ? estimator_variant(o.estimator).uses : kUserEstimatorUses;
+    const unsigned uses = in.planned.plan.variants.estimator.uses;
     nlohmann::json j = {
         {"scene", o.scene},
         {"width", o.width},
@@ -28,18 +29,18 @@ nlohmann::json render_stats_json(const RenderStatsInput& in) {
         {"seed", o.seed},
         {"mis_heuristic", o.mis_heuristic},
         {"materials", o.materials},
-        {"microfacet", in.gpu_scene.microfacet},
-        {"sky", {in.settings.sky.r, in.settings.sky.g, in.settings.sky.b}},
-        {"sky_light", in.settings.sky_light},
+        {"microfacet", gpu_scene.microfacet},
+        {"sky", {settings.sky.r, settings.sky.g, settings.sky.b}},
+        {"sky_light", settings.sky_light},
         {"ao_distance", o.ao_distance},
-        {"max_depth", in.settings.max_depth},
-        {"rr_depth", in.settings.rr_depth},
+        {"max_depth", settings.max_depth},
+        {"rr_depth", settings.rr_depth},
         {"seconds_total", in.seconds_total},
         {"seconds_render", result.seconds_render},
         {"seconds_kernel_build", result.seconds_build},
         // Wall clock from the first launch to the last result: kernels, launch gaps, host work.
         {"seconds_render_wall", result.seconds_render_wall},
-        // From the start of the command to the first batch in the image (issue 16's start-up).
+        // From the start of the command to the first batch in the image (its start-up).
         {"seconds_to_first_batch", in.seconds_to_render + result.seconds_first_batch},
         {"seconds_bvh_build", bvh.stats.build_seconds},
         {"samples_per_second", result.seconds_render > 0 ? samples / result.seconds_render : 0.0},
@@ -54,8 +55,8 @@ nlohmann::json render_stats_json(const RenderStatsInput& in) {
         {"variance_estimate", result.replicates > 1 ? "replicates" : "samples"},
         {"variance_clamped", result.variance_clamped},
         {"nonfinite_pixels", 0},  // run_render writes no image with any
-        {"triangles", in.scene.triangle_count()},
-        {"lights", in.gpu_scene.lights.size()},
+        {"triangles", in.planned.scene.scene.triangle_count()},
+        {"lights", gpu_scene.lights.size()},
         // The 4-wide tree the kernels traverse; the binary SAH tree it collapses as binary_*.
         {"bvh",
          {{"nodes", bvh.nodes4.size()},

@@ -6,6 +6,7 @@
 #include "bvh/bvh.h"
 #include "cli/render_command.h"
 #include "render/gpu_scene.h"
+#include "render/plan.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
 
@@ -13,10 +14,7 @@ namespace mcrt {
 
 struct RenderStatsInput {
     const RenderOptions& options;
-    const RenderSettings& settings;
-    const Scene& scene;
-    const Bvh& bvh;
-    const GpuSceneData& gpu_scene;
+    const PlannedRender& planned;
     const RenderResult& result;
     double seconds_total = 0;
     double seconds_to_render = 0;  // from the command's start to render(): load, BVH, upload

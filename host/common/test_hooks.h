@@ -1,6 +1,9 @@
-// Test hooks: let the end-to-end tests stop mcrt at a known point (writing an output, after the
-// outputs are complete) without timing guesses. Inert unless MCRT_TEST_PAUSE names the point.
+// Test hooks, all in one place: let the end-to-end tests stop mcrt at a known point (writing an
+// output, after the outputs are complete) without timing guesses, and make a device fail, slow
+// or wrong. Each is inert unless its environment variable is set (common/environment.h).
 #pragma once
+
+#include <cstdint>
 
 namespace mcrt {
 
@@ -22,5 +25,13 @@ bool test_wrong_device(int device);
 // True when MCRT_TEST_COMPILER_CRASH names device index `device`: a child build for it
 // (host/cl/build_child.h) dies of SIGSEGV, as Intel's compiler did.
 bool test_compiler_crash(int device);
+
+// The launch (counted from 1) at which device `device` fails, when MCRT_FAULT_INJECT is "D:N"
+// for it; 0: never.
+uint64_t test_fault_launch(int device);
+
+// How many times slower device `device` reports itself, when MCRT_SLOW_DEVICE is "D:F" for it
+// (at least 1); 1 otherwise.
+double test_slow_factor(int device);
 
 }  // namespace mcrt

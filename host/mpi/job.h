@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "cli/render_command.h"
+#include "render/plan.h"
 #include "render/renderer.h"
 #include "scene/gltf_import.h"
 
@@ -60,6 +60,8 @@ class RenderJob {
 // Every rank but 0: receives the inputs, sets up its devices, renders the items rank 0 hands
 // them until told to stop, and returns rank 0's exit status. Prints nothing: what goes wrong
 // here reaches rank 0 as a warning (a setup that fails, a device that fails) and its status.
-int serve_render(const RenderOptions& o);
+// `request` and `devices` are this rank's own reading of the command line (the same on every
+// rank); the scene and the estimator's text come from rank 0.
+int serve_render(const RenderRequest& request, const std::vector<std::string>& devices);
 
 }  // namespace mcrt

@@ -16,7 +16,8 @@
 #include <thread>
 
 #include "bvh/bvh.h"
-#include "cli/device_select.h"
+#include "cl/device_select.h"
+#include "common/environment.h"
 #include "common/error.h"
 #include "mpi/job.h"
 #include "mpi/mpi_comm.h"
@@ -32,8 +33,8 @@ int g_rank = 0, g_size = 1;
 bool g_joined = false;
 
 bool launched_by_mpi() {
-    for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"})
-        if (std::getenv(name)) return true;
+    for (EnvironmentVariable v : {kEnvOmpiWorldSize, kEnvPmixRank, kEnvPmiRank, kEnvPmiSize})
+        if (environment(v)) return true;
     return false;
 }
 
@@ -224,7 +225,7 @@ void serve_device(RenderWorker& worker, int slot) {
 
 }  // namespace
 
-int serve_render(const RenderOptions& o) {
+int serve_render(const RenderRequest& request, const std::vector<std::string>& device_names) {
     // Rank 0 decides when the render stops (its signals, its time limit) and tells every rank;
     // mpirun's SIGTERM to all ranks at Ctrl-C must not end this one before rank 0 has the
     // samples it is rendering.
@@ -239,36 +240,26 @@ int serve_render(const RenderOptions& o) {
     wire::Hello hello;
     hello.host = mpi::host_name();
     auto warn = [&](const std::string& w) { hello.warnings.push_back(w); };
-    RenderSettings settings;
-    GpuSceneData gpu_scene;
+    PlannedRender render;
     std::vector<std::unique_ptr<DeviceContext>> contexts;
     std::vector<std::unique_ptr<DeviceWorker>> workers;
     try {
         FileBundle files;
-        std::string estimator_source;
-        wire::decode_inputs(bytes, files, estimator_source);
+        RenderRequest r = request;
+        wire::decode_inputs(bytes, files, r.settings.estimator_source);
         bytes = {};
-        settings = render_settings(o, &estimator_source);
-        Scene scene = load_gltf_from_bundle(o.scene, files, {});  // rank 0 printed its warnings
-        apply_materials_option(scene, settings);
+        SceneSource source;
+        source.bundle = &files;
+        render = plan_render(r, source, {});  // rank 0 printed the scene's warnings
         files.clear();
-        const Camera camera = render_camera(scene, o);
-        const std::vector<DeviceInfo> devices = select_devices(o.devices, warn);
-        Bvh bvh = build_bvh(scene);
-        gpu_scene = make_gpu_scene(scene, bvh, camera, o.width, o.height,
-                                   light_select_uses_tree(settings.light_select));
-        const uint64_t fixed_batch =
-            settings.batch > 0 ? uint64_t(settings.width) * settings.height *
-                                     batch_samples_per_pixel(settings.batch, settings.width,
-                                                             settings.height, settings.spp)
-                               : 0;
+        const std::vector<DeviceInfo> devices = select_devices(device_names, warn);
         if (devices.size() > size_t(mpi::kMaxSlots))
             throw RuntimeError("more than " + std::to_string(mpi::kMaxSlots) + " devices");
         for (const DeviceInfo& d : devices) {
             try {
                 contexts.push_back(std::make_unique<DeviceContext>(d));
-                workers.push_back(std::make_unique<DeviceWorker>(*contexts.back(), gpu_scene,
-                                                                 settings, fixed_batch));
+                workers.push_back(
+                    std::make_unique<DeviceWorker>(*contexts.back(), render.scene.gpu, render.plan));
             } catch (const std::exception& e) {
                 warn("skipping device " + std::to_string(d.index) + " ('" + d.name +
                      "'): " + e.what());

@@ -1,5 +1,7 @@
 #include "mpi/mpi_comm.h"
 
+#include "common/environment.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
@@ -58,7 +60,7 @@ wire::Bytes receive_bytes(int source, int tag) {
 }
 
 double silence_timeout() {
-    const char* text = std::getenv("MCRT_MPI_TIMEOUT");
+    const char* text = environment(kEnvMpiTimeout);
     const double seconds = text ? std::atof(text) : 0.0;
     return seconds > 0 ? seconds : 120.0;
 }

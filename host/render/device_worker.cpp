@@ -9,6 +9,8 @@
 #include "cl/cl_error.h"
 #include "cl/program.h"
 #include "common/error.h"
+#include "common/test_hooks.h"
+#include "render/plan.h"
 #include "render/render_program.h"
 
 namespace mcrt {
@@ -30,17 +32,6 @@ cl::Buffer device_buffer(const DeviceContext& device, cl_mem_flags flags, size_t
     return buffer;
 }
 
-// "D:V" from an environment variable: device index D and a value, for testing and simulation.
-bool device_switch(const char* name, int device_index, double* value) {
-    const char* text = std::getenv(name);
-    if (!text) return false;
-    int d = -1;
-    double v = 0;
-    if (std::sscanf(text, "%d:%lf", &d, &v) != 2 || d != device_index) return false;
-    *value = v;
-    return true;
-}
-
 constexpr size_t kGroupSize = 64;
 
 uint64_t round_up(uint64_t n, uint64_t m) { return (n + m - 1) / m * m; }
@@ -58,23 +49,23 @@ void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene,
     CL_CHECK(render.setArg(gpu::RENDER_ARG_TRIANGLE_INFO, scene.triangle_info));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_MATERIALS, scene.materials));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_LIGHTS, scene.lights));
-    CL_CHECK(render.setArg(gpu::RENDER_ARG_LIGHT_CDF, scene.light_cdf));
-    CL_CHECK(render.setArg(gpu::RENDER_ARG_LIGHT_ALIAS, scene.light_alias));
-    CL_CHECK(render.setArg(gpu::RENDER_ARG_LIGHT_TREE, scene.light_tree));
+    CL_CHECK(render.setArg(gpu::RENDER_ARG_LIGHT_SELECTION, scene.light_selection));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_CAMERA, scene.camera));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_SAMPLES, samples));
 }
 
 DeviceWorker::DeviceWorker(const DeviceContext& device, const GpuSceneData& scene,
-                           const RenderSettings& settings, uint64_t fixed_batch_samples)
-    : device_(device), settings_(settings), fixed_batch_(fixed_batch_samples) {
+                           const RenderPlan& plan)
+    : device_(device),
+      settings_(plan.settings),
+      fixed_batch_(plan.fixed_batch),
+      fail_at_launch_(test_fault_launch(device.info.index)),
+      slow_factor_(test_slow_factor(device.info.index)) {
     report.name = device.info.name;
     report.index = device.info.index;
-    double v;
-    if (device_switch("MCRT_FAULT_INJECT", device.info.index, &v)) fail_at_launch_ = uint64_t(v);
-    if (device_switch("MCRT_SLOW_DEVICE", device.info.index, &v)) slow_factor_ = std::max(1.0, v);
+    const RenderSettings& settings = plan.settings;
 
-    cl::Program program = render_program(device, settings, scene.microfacet);
+    cl::Program program = render_program(device, plan);
     render_ = make_kernel(program, "render");
     reduce_ = make_kernel(program, "reduce_chunks");
     buffers_ = std::make_unique<GpuSceneBuffers>(device, scene);
@@ -151,6 +142,7 @@ void DeviceWorker::start(const WorkItem& item) {
     params.seed = settings_.seed;
     params.spp = settings_.spp;
     params.light_count = buffers_->light_count;
+    params.light_tree_nodes = buffers_->light_tree_nodes;
     params.pixel_begin = item.pixel_begin;
     params.pixel_end = item.pixel_end;
     params.sample_begin = sample_begin;

@@ -11,6 +11,7 @@
 #include "render/accumulator.h"
 #include "render/gpu_scene.h"
 #include "render/render_worker.h"
+#include "render/plan.h"
 #include "render/renderer.h"
 #include "render/work_queue.h"
 
@@ -25,9 +26,9 @@ class DeviceWorker : public RenderWorker {
   public:
     // Builds the program, uploads the scene and allocates the batch buffers; throws RuntimeError
     // when the device cannot hold them, InputError for a user's estimator that does not build.
-    // `fixed_batch_samples` > 0 makes every launch that many samples (--batch).
-    DeviceWorker(const DeviceContext& device, const GpuSceneData& scene,
-                 const RenderSettings& settings, uint64_t fixed_batch_samples);
+    // The plan's fixed_batch > 0 makes every launch that many samples (--batch). `plan` must
+    // outlive the worker.
+    DeviceWorker(const DeviceContext& device, const GpuSceneData& scene, const RenderPlan& plan);
     // Waits for the commands still in flight: they write into this worker's host memory.
     ~DeviceWorker() override;
 
@@ -57,9 +58,10 @@ private:
     const DeviceContext& device_;
     const RenderSettings& settings_;
     uint64_t fixed_batch_;
+    uint64_t fail_at_launch_;  // test hooks (common/test_hooks.h)
+    double slow_factor_;
     uint64_t max_samples_ = 0;
-    uint64_t launches_ = 0, fail_at_launch_ = 0;
-    double slow_factor_ = 1.0;
+    uint64_t launches_ = 0;
     double pending_busy_ = 0;
     uint64_t pending_samples_ = 0;
     uint64_t largest_launch_ = 0;  // samples of the largest committed launch

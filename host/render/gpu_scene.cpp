@@ -26,7 +26,7 @@ gpu::CameraGpu make_gpu_camera(const Camera& camera, int width, int height) {
 }
 
 GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& camera, int width,
-                            int height, bool light_tree) {
+                            int height, LightSelection selection) {
     GpuSceneData data;
     data.nodes = bvh.nodes4;
     data.packets = bvh.packets;
@@ -35,13 +35,16 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
         // KHR_materials_specular: the dielectric's F0 = min(0.04 specularColor, 1) × specular
         // and F90 = specular; GGX α = roughness², at least MCRT_ALPHA_MIN.
         const float alpha = std::max(m.roughness * m.roughness, MCRT_ALPHA_MIN);
-        g.albedo = to_float4(m.albedo, m.metallic);
-        g.Le = to_float4(m.emission, alpha);
+        g.base_color = to_float4(m.albedo, 1.0f);
+        g.emission = to_float4(m.emission);
         g.specular = to_float4(glm::min(0.04f * m.specular_color, glm::vec3(1.0f)) * m.specular,
                                m.specular);
+        g.metallic = m.metallic;
+        g.alpha = alpha;
+        g.type = m.lambertian() ? MATERIAL_LAMBERTIAN : MATERIAL_METALLIC_ROUGHNESS;
         g.flags = m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u;
         data.materials.push_back(g);
-        data.microfacet = data.microfacet || !m.lambertian();
+        data.microfacet = data.microfacet || g.type != MATERIAL_LAMBERTIAN;
     }
     if (data.materials.empty()) data.materials.push_back(gpu::Material{});
 
@@ -54,20 +57,22 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
         const Material& m = scene.materials[scene.triangle_material[e.triangle]];
         const glm::vec3* p = &scene.positions[3 * size_t(e.triangle)];
         gpu::Light light{};
-        light.p0 = to_float4(p[0], e.area);
-        light.p1 = to_float4(p[1], gpu::as_float(m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u));
+        light.p0 = to_float4(p[0]);
+        light.p1 = to_float4(p[1]);
         light.p2 = to_float4(p[2]);
         light.Le = to_float4(m.emission);
+        light.area = e.area;
+        light.flags = m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u;
         data.lights.push_back(light);
         powers.push_back(e.power);
         light_of_triangle[e.triangle] = uint32_t(data.lights.size());
     }
-    data.light_cdf = build_cdf(powers);
-    data.light_alias = build_alias_table(powers);
-    if (light_tree) {
-        LightTree tree = build_light_tree(data.lights, powers);
-        store_light_trails(tree, data.lights);
-        data.light_tree = std::move(tree.nodes);
+    data.light_selection = selection;
+    switch (selection) {
+        case LightSelection::Uniform: break;
+        case LightSelection::Power: data.light_cdf = build_cdf(powers); break;
+        case LightSelection::Alias: data.light_alias = build_alias_table(powers); break;
+        case LightSelection::Tree: data.light_tree = build_light_tree(data.lights, powers); break;
     }
     // Shading's view of each packet lane (unused lanes stay zero: no ray hits them).
     data.triangle_info.assign(bvh.packets.size() * MCRT_PACKET_WIDTH, gpu::TriangleInfo{});
@@ -83,6 +88,24 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
     }
     data.camera = make_gpu_camera(camera, width, height);
     return data;
+}
+
+std::vector<uint32_t> light_selection_words(const GpuSceneData& data, uint32_t* tree_nodes) {
+    *tree_nodes = 0;
+    auto words = [](const auto& items) {
+        std::vector<uint32_t> w(items.size() * sizeof(items[0]) / sizeof(uint32_t));
+        if (!items.empty()) std::memcpy(w.data(), items.data(), w.size() * sizeof(uint32_t));
+        return w;
+    };
+    switch (data.light_selection) {
+        case LightSelection::Uniform: return {};
+        case LightSelection::Power: return words(data.light_cdf);
+        case LightSelection::Alias: return words(data.light_alias);
+        case LightSelection::Tree:
+            *tree_nodes = uint32_t(std::max<size_t>(data.light_tree.nodes.size(), 1));
+            return light_tree_words(data.light_tree);
+    }
+    return {};
 }
 
 template <typename T>
@@ -109,9 +132,8 @@ GpuSceneBuffers::GpuSceneBuffers(const DeviceContext& device, const GpuSceneData
     triangle_info = upload(device, data.triangle_info, bytes, "triangle materials and lights");
     materials = upload(device, data.materials, bytes, "materials");
     lights = upload(device, data.lights, bytes, "lights");
-    light_cdf = upload(device, data.light_cdf, bytes, "light CDF");
-    light_alias = upload(device, data.light_alias, bytes, "light alias table");
-    light_tree = upload(device, data.light_tree, bytes, "light tree");
+    light_selection = upload(device, light_selection_words(data, &light_tree_nodes), bytes,
+                             "light selection data");
     camera = upload(device, std::vector<gpu::CameraGpu>{data.camera}, bytes, "camera");
     light_count = cl_uint(data.lights.size());
 }

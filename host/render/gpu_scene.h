@@ -9,6 +9,8 @@
 
 #include "bvh/bvh.h"
 #include "cl/device.h"
+#include "render/light_tree.h"
+#include "render/variants.h"
 #include "scene/scene.h"
 #include "shared_types.h"
 
@@ -20,11 +22,15 @@ struct GpuSceneData {
     std::vector<gpu::TriangleInfo> triangle_info;  // per packet lane: 4 per packet
     std::vector<gpu::Material> materials;
     std::vector<gpu::Light> lights;
-    std::vector<float> light_cdf;  // lights + 1 entries, by power (PBRT 3rd ed. 13.3.1)
-    std::vector<gpu::AliasEntry> light_alias;  // the same distribution as an alias table
-    std::vector<gpu::LightTreeNode> light_tree;  // --light-select tree (render/light_tree.h)
+    // The light selection's own data, only that of `light_selection` built: power's CDF
+    // (lights + 1 entries, PBRT 3rd ed. 13.3.1), alias's table of the same distribution, or the
+    // tree (render/light_tree.h); uniform has none.
+    LightSelection light_selection = LightSelection::Power;
+    std::vector<float> light_cdf;
+    std::vector<gpu::AliasEntry> light_alias;
+    LightTree light_tree;
     gpu::CameraGpu camera{};
-    // Some surface is not Lambertian: the kernels need the microfacet BRDF (-D
+    // Some material's type is not MATERIAL_LAMBERTIAN: the kernels need that model (-D
     // MCRT_MATERIALS_GLTF); a Lambertian scene's kernels are built without it.
     bool microfacet = false;
 };
@@ -32,18 +38,21 @@ struct GpuSceneData {
 // The camera of DESIGN.md's camera contract for an image of width × height.
 gpu::CameraGpu make_gpu_camera(const Camera& camera, int width, int height);
 
-// Flattens the scene, its BVH and its emitters; `camera` as chosen by the caller. The light
-// tree is built only with `light_tree` (the other selections never read it: it costs about
-// 128 bytes per light).
+// Flattens the scene, its BVH and its emitters, with the data of the light selection
+// `selection` alone; `camera` as chosen by the caller.
 GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& camera, int width,
-                            int height, bool light_tree = true);
+                            int height, LightSelection selection = LightSelection::Power);
+
+// The light selection's buffer as the kernels read it (RENDER_ARG_LIGHT_SELECTION), in 32-bit
+// words; `tree_nodes` the nodes at its head for the tree, else 0.
+std::vector<uint32_t> light_selection_words(const GpuSceneData& data, uint32_t* tree_nodes);
 
 // Device copies of GpuSceneData (empty arrays get a one-element buffer, never a null one).
 struct GpuSceneBuffers {
     GpuSceneBuffers(const DeviceContext& device, const GpuSceneData& data);
-    cl::Buffer nodes, packets, triangle_info, materials, lights, light_cdf, light_alias, light_tree,
-        camera;
+    cl::Buffer nodes, packets, triangle_info, materials, lights, light_selection, camera;
     cl_uint light_count = 0;
+    cl_uint light_tree_nodes = 0;
     size_t bytes = 0;
 };
 

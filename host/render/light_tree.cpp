@@ -1,5 +1,7 @@
 #include "render/light_tree.h"
 
+#include <cstring>
+
 #include <algorithm>
 #include <cmath>
 #include <glm/glm.hpp>
@@ -141,8 +143,7 @@ struct Builder {
             const uint32_t light = order[begin];
             out.nodes[index].child = light;
             out.nodes[index].flags |= LIGHT_NODE_LEAF;
-            out.trail[light] = trail;
-            out.depth_plus_one[light] = uint32_t(depth) + 1u;
+            out.paths[light] = {trail, uint32_t(depth) + 1u};
             return;
         }
         size_t mid = split(begin, end, all, centroids, depth);
@@ -219,8 +220,7 @@ struct Builder {
 LightTree build_light_tree(const std::vector<gpu::Light>& lights,
                            const std::vector<double>& powers) {
     LightTree tree;
-    tree.trail.assign(lights.size(), 0u);
-    tree.depth_plus_one.assign(lights.size(), 0u);
+    tree.paths.assign(lights.size(), gpu::LightTreePath{0u, 0u});
     std::vector<Bounds> items(lights.size());
     std::vector<glm::dvec3> centroid(lights.size());
     std::vector<uint32_t> order;
@@ -240,7 +240,7 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
         // A sliver whose normal is lost to rounding may emit anywhere: the whole sphere.
         b.normals = length > 0.0 ? Cone{normal / length, 1.0, false} : whole_sphere({0, 0, 1});
         b.cos_e = 0.0;
-        b.two_sided = (gpu::as_uint(l.p1.w) & MATERIAL_DOUBLE_SIDED) != 0u;
+        b.two_sided = (l.flags & MATERIAL_DOUBLE_SIDED) != 0u;
         centroid[i] = 0.5 * (b.lo + b.hi);
         order.push_back(uint32_t(i));
     }
@@ -252,11 +252,18 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
     return tree;
 }
 
-void store_light_trails(const LightTree& tree, std::vector<gpu::Light>& lights) {
-    for (size_t i = 0; i < lights.size(); ++i) {
-        lights[i].Le.w = gpu::as_float(tree.trail[i]);
-        lights[i].p2.w = gpu::as_float(tree.depth_plus_one[i]);
-    }
+std::vector<uint32_t> light_tree_words(const LightTree& tree) {
+    const size_t nodes = std::max<size_t>(tree.nodes.size(), 1);  // an empty tree: one zero node
+    std::vector<uint32_t> words((nodes * sizeof(gpu::LightTreeNode) +
+                                 tree.paths.size() * sizeof(gpu::LightTreePath)) /
+                                    sizeof(uint32_t),
+                                0u);
+    if (!tree.nodes.empty())
+        std::memcpy(words.data(), tree.nodes.data(), tree.nodes.size() * sizeof(gpu::LightTreeNode));
+    if (!tree.paths.empty())
+        std::memcpy(words.data() + nodes * sizeof(gpu::LightTreeNode) / sizeof(uint32_t),
+                    tree.paths.data(), tree.paths.size() * sizeof(gpu::LightTreePath));
+    return words;
 }
 
 }  // namespace mcrt

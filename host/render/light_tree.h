@@ -14,8 +14,9 @@ namespace mcrt {
 struct LightTree {
     std::vector<gpu::LightTreeNode> nodes;  // nodes[0] the root; empty when no light has power
     // Per light: its path from the root (bit d set: second child at depth d) and the path's
-    // length plus one, 0 for a light outside the tree (zero power), as Light.Le.w and .p2.w hold.
-    std::vector<uint32_t> trail, depth_plus_one;
+    // length plus one, 0 for a light outside the tree (zero power): what the kernels' pmf twin
+    // walks, uploaded after the nodes.
+    std::vector<gpu::LightTreePath> paths;
 };
 
 // Builds the tree over `lights` (vertices and MATERIAL_DOUBLE_SIDED from gpu::Light) weighted by
@@ -26,7 +27,8 @@ struct LightTree {
 LightTree build_light_tree(const std::vector<gpu::Light>& lights,
                            const std::vector<double>& powers);
 
-// Writes each light's trail into its Le.w and p2.w bits (what the kernels' pmf twin walks).
-void store_light_trails(const LightTree& tree, std::vector<gpu::Light>& lights);
+// The tree as the kernels read it from the selection's buffer: its nodes (at least one), then
+// one path per light (RENDER_ARG_LIGHT_SELECTION), as 32-bit words.
+std::vector<uint32_t> light_tree_words(const LightTree& tree);
 
 }  // namespace mcrt

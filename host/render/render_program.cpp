@@ -9,6 +9,8 @@
 
 #include "common/error.h"
 #include "common/test_hooks.h"
+#include "common/environment.h"
+#include "render/plan.h"
 #include "render/renderer.h"
 #include "render/variants.h"
 #include "shared_types.h"
@@ -18,48 +20,6 @@ namespace mcrt {
 float sky_light_pmf(const RenderSettings& settings, uint32_t light_count) {
     if (!settings.sky_light) return 0.0f;
     return light_count > 0 ? 0.5f : 1.0f;
-}
-
-std::string render_program_options(const RenderSettings& settings, bool microfacet) {
-    std::string options = "-cl-std=CL1.2";
-    unsigned uses = kUserEstimatorUses;
-    if (settings.max_depth > MCRT_MAX_PATH_DEPTH)
-        throw InputError("--max-depth " + std::to_string(settings.max_depth) + ": at most " +
-                         std::to_string(MCRT_MAX_PATH_DEPTH));
-    if (settings.rr_depth < 1 || settings.rr_depth > MCRT_MAX_PATH_DEPTH)
-        throw InputError("--rr-depth " + std::to_string(settings.rr_depth) + ": expected 1 .. " +
-                         std::to_string(MCRT_MAX_PATH_DEPTH));
-    if (settings.estimator_file.empty()) {
-        const EstimatorVariant& estimator = estimator_variant(settings.estimator);
-        options += std::string(" -D MCRT_ESTIMATE=") + estimator.function;
-        uses = estimator.uses;
-        // The ambient estimators integrate sky visibility, not reflected light: no path to extend.
-        if ((uses & kUsesSky) && settings.max_depth > 1)
-            throw InputError("--max-depth " + std::to_string(settings.max_depth) +
-                             ": --estimator " + settings.estimator +
-                             " is an ambient estimator (sky visibility, one bounce): --max-depth "
-                             "0 or 1; path tracing under the sky is --sky R,G,B with light-area, "
-                             "light-solid-angle, bsdf, hemisphere-* or mis");
-        if (uses & kUsesSky) options += " -D ESTIMATOR_USES_SKY";
-    } else {
-        options += std::string(" -D MCRT_ESTIMATE=") + kUserEstimatorFunction;
-    }
-    options += std::string(" -D ") +
-               option_variant(kLightSelectVariants, settings.light_select, "--light-select").macro;
-    options +=
-        std::string(" -D ") + option_variant(kSamplerVariants, settings.sampler, "--sampler").macro;
-    const OptionVariant& heuristic =
-        option_variant(kMisHeuristicVariants, settings.mis_heuristic, "--mis-heuristic");
-    if ((uses & kUsesMisHeuristic) && heuristic.macro)
-        options += std::string(" -D ") + heuristic.macro;
-    const OptionVariant& materials =
-        option_variant(kMaterialVariants, settings.materials, "--materials");
-    if (microfacet && materials.macro) options += std::string(" -D ") + materials.macro;
-    // Development override, as MCRT_KERNEL_DIR is for the sources: extra build options, e.g.
-    // the -D switches of scripts/profile_stages.py (docs/BENCHMARKS.md, issue 16).
-    if (const char* extra = std::getenv("MCRT_KERNEL_OPTIONS"); extra && *extra)
-        options += std::string(" ") + extra;
-    return options;
 }
 
 KernelReplacements render_program_replacements(const RenderSettings& settings) {
@@ -92,10 +52,14 @@ std::string first_error_in(const std::string& log, const std::string& file) {
 
 }  // namespace
 
-cl::Program render_program(const DeviceContext& device, const RenderSettings& settings,
-                           bool microfacet) {
+cl::Program render_program(const DeviceContext& device, const RenderPlan& plan) {
+    const RenderSettings& settings = plan.settings;
     try {
-        std::string options = render_program_options(settings, microfacet);
+        std::string options = plan.program_options;
+        // Development override, as MCRT_KERNEL_DIR is for the sources: extra build options, e.g.
+        // the -D switches of the stage profiler (docs/BENCHMARKS.md).
+        if (const std::string extra = environment_value(kEnvKernelOptions); !extra.empty())
+            options += " " + extra;
         if (test_wrong_device(device.info.index)) options += " -D MCRT_TEST_WRONG_VALUES";
         return cached_program(device, "render.cl", options, render_program_replacements(settings));
     } catch (const RuntimeError& e) {

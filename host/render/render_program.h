@@ -1,5 +1,5 @@
-// The render program of a render's settings: its -D options from the table of variants, a
-// user's estimator file in place of kernels/user_estimator.cl, and its build on one device.
+// The render program of a render's plan: its -D options (RenderPlan::program_options), a user's
+// estimator file in place of kernels/user_estimator.cl, and its build on one device.
 #pragma once
 
 #include <CL/opencl.hpp>
@@ -12,10 +12,7 @@
 namespace mcrt {
 
 struct RenderSettings;
-
-// The -D options of the render program (throws InputError for a name no table has);
-// `microfacet`: the scene has a surface that is not Lambertian (GpuSceneData::microfacet).
-std::string render_program_options(const RenderSettings& settings, bool microfacet = false);
+struct RenderPlan;
 
 // Probability that the light strategies choose the sky light (RenderParams::sky.w): 0 when the
 // sky is no light, 1 when it is the only one, else 1/2 beside the area lights, the exact split of
@@ -28,8 +25,7 @@ KernelReplacements render_program_replacements(const RenderSettings& settings);
 // The render program built (once per process) for the device. A build error in a user's
 // estimator file throws InputError whose first line names FILE:LINE and the compiler's message,
 // followed by the build log; any other build failure throws RuntimeError with the log.
-cl::Program render_program(const DeviceContext& device, const RenderSettings& settings,
-                           bool microfacet);
+cl::Program render_program(const DeviceContext& device, const RenderPlan& plan);
 
 // The text of a user's estimator file; throws InputError when it is not a readable regular file
 // or defines no `estimate` function.

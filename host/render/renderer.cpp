@@ -15,6 +15,7 @@
 #include "common/error.h"
 #include "render/accumulator.h"
 #include "render/device_worker.h"
+#include "render/plan.h"
 #include "render/render_program.h"
 #include "render/render_worker.h"
 #include "render/variants.h"
@@ -123,24 +124,6 @@ void check_agreement(std::vector<std::unique_ptr<RenderWorker>>& workers, size_t
 
 }  // namespace
 
-uint32_t resolve_replicates(uint32_t requested, const RenderSettings& settings) {
-    if (requested > 0) {
-        if (MCRT_SAMPLES_PER_CHUNK % requested != 0 || settings.spp % requested != 0)
-            throw InputError("--replicates " + std::to_string(requested) +
-                             ": expected 1, 2, 4, 8 or 16, dividing --spp " +
-                             std::to_string(settings.spp));
-        return requested;
-    }
-    const bool correlated =
-        settings.sampler != "independent" ||
-        (settings.estimator_file.empty() &&
-         (estimator_variant(settings.estimator).uses & kUsesCorrelatedSamples));
-    if (!correlated) return 1;  // independent samples: their own variance is honest
-    uint32_t k = kDefaultReplicates;
-    while (settings.spp % k != 0) k /= 2;  // the largest power of two up to it dividing spp
-    return k;
-}
-
 uint32_t batch_samples_per_pixel(uint32_t requested, int width, int height, uint32_t spp) {
     const uint32_t chunk = MCRT_SAMPLES_PER_CHUNK;
     uint64_t batch = requested;
@@ -151,29 +134,21 @@ uint32_t batch_samples_per_pixel(uint32_t requested, int width, int height, uint
 }
 
 RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuSceneData& scene,
-                    const RenderSettings& settings, const ProgressSink& progress,
+                    const RenderPlan& plan, const ProgressSink& progress,
                     const RenderControl& control,
                     const std::function<void(const std::string&)>& warn,
                     const RemoteWorkers& remote) {
     auto start = std::chrono::steady_clock::now();
-    render_program_options(settings);  // rejects unknown settings before any device work
-    if (settings.replicates == 0 || MCRT_SAMPLES_PER_CHUNK % settings.replicates != 0 ||
-        settings.spp % settings.replicates != 0)
-        throw InputError("--replicates " + std::to_string(settings.replicates) +
-                         ": must divide 16 and --spp " + std::to_string(settings.spp));
+    const RenderSettings& settings = plan.settings;
     const uint32_t pixels = uint32_t(settings.width) * uint32_t(settings.height);
-    const uint64_t fixed_batch =
-        settings.batch > 0
-            ? uint64_t(pixels) *
-                  batch_samples_per_pixel(settings.batch, settings.width, settings.height, settings.spp)
-            : 0;
+    const uint64_t fixed_batch = plan.fixed_batch;
 
     // Set up every device; one that cannot hold the scene is skipped with a warning.
     std::vector<std::unique_ptr<RenderWorker>> workers;
     std::string last_error;
     for (const DeviceContext* d : devices) {
         try {
-            workers.push_back(std::make_unique<DeviceWorker>(*d, scene, settings, fixed_batch));
+            workers.push_back(std::make_unique<DeviceWorker>(*d, scene, plan));
         } catch (const RuntimeError& e) {
             if (devices.size() == 1 && !remote) throw;
             last_error = e.what();
@@ -336,6 +311,15 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
     result.devices = device_reports();
     for (const DeviceReport& d : result.devices) result.seconds_render += d.seconds_busy;
     return result;
+}
+
+RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuSceneData& scene,
+                    const RenderSettings& settings, const ProgressSink& progress,
+                    const RenderControl& control,
+                    const std::function<void(const std::string&)>& warn,
+                    const RemoteWorkers& remote) {
+    const RenderPlan plan = make_render_plan(settings, scene);
+    return render(devices, scene, plan, progress, control, warn, remote);
 }
 
 RenderResult render(const DeviceContext& device, const GpuSceneData& scene,

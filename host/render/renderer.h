@@ -16,7 +16,8 @@
 
 namespace mcrt {
 
-// Variants are named as in the tables of render/variants.h.
+// What a render is, as plain data: variants are named as in the tables of render/variants.h and
+// resolved once into a plan (render/plan.h).
 struct RenderSettings {
     int width = 512, height = 512;
     uint32_t spp = 16;
@@ -81,12 +82,21 @@ struct RenderControl {
     const volatile std::sig_atomic_t* interrupted = nullptr;
 };
 
-// Renders on every device at once: work is handed out dynamically, each device's launches sized
-// to take about 150 ms; a device that fails is retired with a warning and its work redone on the
-// others. The image is bitwise identical whatever the devices, batch sizes and timing (for
-// devices that round identically). Throws InputError for settings it cannot honour,
-// RuntimeError when no device can render. `remote` adds the devices of other MPI ranks, handed
-// work from the same queue.
+struct RenderPlan;  // render/plan.h
+
+// Renders the plan on every device at once: work is handed out dynamically, each device's
+// launches sized to take about 150 ms; a device that fails is retired with a warning and its
+// work redone on the others. The image is bitwise identical whatever the devices, batch sizes
+// and timing (for devices that round identically). Throws RuntimeError when no device can
+// render. `remote` adds the devices of other MPI ranks, handed work from the same queue.
+RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuSceneData& scene,
+                    const RenderPlan& plan, const ProgressSink& progress = {},
+                    const RenderControl& control = {},
+                    const std::function<void(const std::string&)>& warn = {},
+                    const RemoteWorkers& remote = {});
+
+// The same for settings not yet planned (make_render_plan; throws SettingError for settings it
+// cannot honour).
 RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuSceneData& scene,
                     const RenderSettings& settings, const ProgressSink& progress = {},
                     const RenderControl& control = {},
@@ -97,9 +107,9 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
 RenderResult render(const DeviceContext& device, const GpuSceneData& scene,
                     const RenderSettings& settings);
 
-// Replicates for `requested` (0: the default for the settings' sampler and estimator, see
-// render/variants.h) with `spp` samples per pixel: a power of two dividing 16 and spp. Throws
-// InputError for a requested count that is not one.
+// Replicates for `requested` (0: the default of the settings' variants, RenderVariants::
+// correlated) with the settings' spp: a power of two dividing 16 and spp. Throws SettingError
+// for a requested count that is not one (render/plan.cpp).
 uint32_t resolve_replicates(uint32_t requested, const RenderSettings& settings);
 
 // Samples per pixel per launch when --batch is given: rounded up to whole chunks, at most spp

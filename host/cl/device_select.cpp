@@ -1,4 +1,4 @@
-#include "cli/device_select.h"
+#include "cl/device_select.h"
 
 #include <algorithm>
 #include <cctype>

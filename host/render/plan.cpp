@@ -1,0 +1,117 @@
+#include "render/plan.h"
+
+#include "common/error.h"
+
+namespace mcrt {
+
+namespace {
+
+// Replicates for `requested` (0: the default of the variants) with `spp` samples per pixel: a
+// power of two dividing 16 and spp.
+uint32_t replicates_for(uint32_t requested, uint32_t spp, const RenderVariants& variants) {
+    if (requested > 0) {
+        if (MCRT_SAMPLES_PER_CHUNK % requested != 0 || spp % requested != 0)
+            throw SettingError("replicates", std::to_string(requested) +
+                                                 ": expected 1, 2, 4, 8 or 16, dividing spp " +
+                                                 std::to_string(spp));
+        return requested;
+    }
+    if (!variants.correlated()) return 1;  // independent samples: their own variance is honest
+    uint32_t k = kDefaultReplicates;
+    while (spp % k != 0) k /= 2;  // the largest power of two up to it dividing spp
+    return k;
+}
+
+}  // namespace
+
+uint32_t resolve_replicates(uint32_t requested, const RenderSettings& settings) {
+    return replicates_for(requested, settings.spp, resolve_variants(settings));
+}
+
+RenderPlan check_render_settings(RenderSettings settings, const std::optional<glm::vec3>& sky) {
+    RenderPlan plan;
+    plan.variants = resolve_variants(settings);
+    const RenderVariants& v = plan.variants;
+    if (settings.max_depth > MCRT_MAX_PATH_DEPTH)
+        throw SettingError("max_depth", std::to_string(settings.max_depth) + ": at most " +
+                                            std::to_string(MCRT_MAX_PATH_DEPTH));
+    if (settings.rr_depth < 1 || settings.rr_depth > MCRT_MAX_PATH_DEPTH)
+        throw SettingError("rr_depth", std::to_string(settings.rr_depth) + ": expected 1 .. " +
+                                           std::to_string(MCRT_MAX_PATH_DEPTH));
+    // The ambient estimators integrate sky visibility, not reflected light: no path to extend.
+    if (v.ambient() && settings.max_depth > 1)
+        throw SettingError(
+            "max_depth",
+            std::to_string(settings.max_depth) + ": estimator " + v.estimator.name +
+                " is an ambient estimator (sky visibility, one bounce): max_depth 0 or 1; path "
+                "tracing under the sky is a sky light with light-area, light-solid-angle, bsdf, "
+                "hemisphere-* or mis");
+    // The ambient estimators' sky is 1 unless given; for the others a sky makes it a light.
+    if (sky) {
+        settings.sky = *sky;
+        settings.sky_light = v.uses(kUsesSkyLight) && (sky->r > 0 || sky->g > 0 || sky->b > 0);
+    } else {
+        settings.sky = glm::vec3(v.uses(kUsesSky) ? 1.0f : 0.0f);
+        settings.sky_light = false;
+    }
+    settings.replicates = replicates_for(settings.replicates, settings.spp, v);
+    plan.settings = std::move(settings);
+    return plan;
+}
+
+RenderPlan finish_render_plan(RenderPlan plan, const GpuSceneData& scene) {
+    const RenderSettings& s = plan.settings;
+    plan.program_options = variant_program_options(plan.variants, scene.microfacet);
+    plan.fixed_batch =
+        s.batch > 0 ? uint64_t(s.width) * uint64_t(s.height) *
+                          batch_samples_per_pixel(s.batch, s.width, s.height, s.spp)
+                    : 0;
+    return plan;
+}
+
+RenderPlan make_render_plan(const RenderSettings& settings, const GpuSceneData& scene) {
+    RenderPlan plan = check_render_settings(settings, settings.sky);
+    plan.settings.sky = settings.sky;  // the sky as the caller of a device scene chose it
+    plan.settings.sky_light = settings.sky_light;
+    return finish_render_plan(std::move(plan), scene);
+}
+
+Camera choose_camera(const Scene& scene, const CameraChoice& choice) {
+    if (choice.look) return *choice.look;
+    if (choice.index >= 0) {
+        if (size_t(choice.index) >= scene.cameras.size())
+            throw SettingError("camera", std::to_string(choice.index) + ": " + scene.path +
+                                             " has " + std::to_string(scene.cameras.size()) +
+                                             " perspective camera(s)");
+        return scene.cameras[size_t(choice.index)];
+    }
+    return scene.cameras.empty() ? bench_camera(scene) : scene.cameras.front();
+}
+
+Scene read_scene(const std::string& path, const SceneSource& source, const WarningSink& warn) {
+    if (source.bundle) return load_gltf_from_bundle(path, *source.bundle, warn);
+    return load_gltf(path, warn, source.files_read, source.record);
+}
+
+PlannedRender plan_render(const RenderRequest& request, const SceneSource& source,
+                          const WarningSink& warn) {
+    PlannedRender r;
+    r.plan = check_render_settings(request.settings, request.sky);
+    const RenderVariants& v = r.plan.variants;
+    const RenderSettings& s = r.plan.settings;
+    r.scene.scene = read_scene(request.scene, source, warn);
+    Scene& scene = r.scene.scene;
+    if (v.materials->lambertian) make_lambertian(scene.materials);
+    r.scene.camera = choose_camera(scene, request.camera);
+    r.scene.bvh = build_bvh(scene);
+    r.scene.gpu = make_gpu_scene(scene, r.scene.bvh, r.scene.camera, s.width, s.height,
+                                 v.light_select->id);
+    if (warn && scene.triangle_count() == 0) warn(request.scene + ": the scene has no triangles");
+    if (warn && v.uses(kUsesLights) && !s.sky_light && r.scene.gpu.lights.empty())
+        warn(request.scene + ": no emissive triangles: direct lighting is black" +
+             (v.uses(kUsesSkyLight) ? " (--sky R,G,B adds a sky light)" : ""));
+    r.plan = finish_render_plan(std::move(r.plan), r.scene.gpu);
+    return r;
+}
+
+}  // namespace mcrt
