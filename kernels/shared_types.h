@@ -114,14 +114,14 @@ typedef struct {
  * node of the binary tree, so at most MCRT_BVH_MAX_DEPTH - 1 of them lie on a path. */
 #define MCRT_BVH4_MAX_DEPTH (MCRT_BVH_MAX_DEPTH - 1)
 
-/* Triangle in BVH leaf order, 48 bytes, on the host (Bvh::triangles; the device reads vertices
+/* Triangle in BVH leaf order, 64 bytes, on the host (Bvh::triangles; the device reads vertices
  * from TrianglePacket and the rest from TriangleInfo): world-space vertices, counter-clockwise
- * seen from the front. p0.w holds the material index as uint bits; p1.w the scene's triangle
- * index; p2.w is 0. */
+ * seen from the front. */
 typedef struct {
-    float4 p0;
-    float4 p1;
-    float4 p2;
+    float4 p0, p1, p2; /* .w 0 */
+    uint material;     /* index into the materials */
+    uint index;        /* the scene's index of the triangle */
+    uint pad0, pad1;
 } Triangle;
 
 #define MATERIAL_DOUBLE_SIDED 1u
@@ -287,8 +287,8 @@ enum RenderArgument {
     FIELD(Bvh4Node, hi_z, 80) FIELD(Bvh4Node, child, 96) FIELD(Bvh4Node, count, 112)            \
     TYPE(TrianglePacket, 160, 16) FIELD(TrianglePacket, v, 0) FIELD(TrianglePacket, index, 144) \
     TYPE(TriangleInfo, 8, 4) FIELD(TriangleInfo, material, 0) FIELD(TriangleInfo, light, 4)     \
-    TYPE(Triangle, 48, 16) FIELD(Triangle, p0, 0) FIELD(Triangle, p1, 16)                       \
-    FIELD(Triangle, p2, 32)                                                                     \
+    TYPE(Triangle, 64, 16) FIELD(Triangle, p0, 0) FIELD(Triangle, p1, 16)                       \
+    FIELD(Triangle, p2, 32) FIELD(Triangle, material, 48) FIELD(Triangle, index, 52)            \
     TYPE(Material, 64, 16) FIELD(Material, base_color, 0) FIELD(Material, emission, 16)         \
     FIELD(Material, specular, 32) FIELD(Material, metallic, 48) FIELD(Material, alpha, 52)      \
     FIELD(Material, type, 56) FIELD(Material, flags, 60)                                        \

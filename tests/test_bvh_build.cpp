@@ -313,15 +313,14 @@ void validate(const Scene& scene, const Bvh& bvh, const BvhBuildOptions& options
     std::vector<int> seen(n, 0);
     size_t bad_triangles = 0;
     for (const gpu::Triangle& tri : bvh.triangles) {
-        uint32_t id = float_bits(tri.p1.w);
+        uint32_t id = tri.index;
         if (id >= n) {
             ++bad_triangles;
             continue;
         }
         ++seen[id];
         const glm::vec3* p = &scene.positions[3 * size_t(id)];
-        bool ok = float_bits(tri.p0.w) == scene.triangle_material[id] &&
-                  float_bits(tri.p2.w) == 0 && glm::vec3(tri.p0.x, tri.p0.y, tri.p0.z) == p[0] &&
+        bool ok = tri.material == scene.triangle_material[id] && glm::vec3(tri.p0.x, tri.p0.y, tri.p0.z) == p[0] &&
                   glm::vec3(tri.p1.x, tri.p1.y, tri.p1.z) == p[1] &&
                   glm::vec3(tri.p2.x, tri.p2.y, tri.p2.z) == p[2];
         if (!ok) ++bad_triangles;
@@ -456,7 +455,7 @@ Hit traverse(const Bvh& bvh, const Ray& ray, bool& overflow) {
             const gpu::Triangle& tri = bvh.triangles[i];
             float t = intersect(ray, {tri.p0.x, tri.p0.y, tri.p0.z}, {tri.p1.x, tri.p1.y, tri.p1.z},
                                 {tri.p2.x, tri.p2.y, tri.p2.z}, h.t);
-            if (t > 0.0f) h = {t, int64_t(float_bits(tri.p1.w))};
+            if (t > 0.0f) h = {t, int64_t(tri.index)};
         }
     }
     return h;
@@ -492,7 +491,7 @@ Hit traverse4(const Bvh& bvh, const Ray& ray, bool& overflow) {
                 float t =
                     intersect(ray, {tri.p0.x, tri.p0.y, tri.p0.z}, {tri.p1.x, tri.p1.y, tri.p1.z},
                               {tri.p2.x, tri.p2.y, tri.p2.z}, h.t);
-                if (t > 0.0f) h = {t, int64_t(float_bits(tri.p1.w))};
+                if (t > 0.0f) h = {t, int64_t(tri.index)};
             }
         }
         // Unordered, so bounded by 4 per level rather than the kernels' 3.

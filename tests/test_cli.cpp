@@ -13,6 +13,7 @@
 #include <tuple>
 #include <vector>
 
+#include "common/environment.h"
 #include "image/image.h"
 #include "render/variants.h"
 #include "process_support.h"
@@ -568,5 +569,32 @@ TEST_CASE("the EXR and the stats say which variance estimate the layer holds", "
         CHECK(bytes.find("mcrt.replicates") != std::string::npos);
         CHECK(bytes.find(std::string(replicates) == "1" ? "the samples' variance over their number"
                                                         : "independent replicate means") != std::string::npos);
+    }
+}
+
+TEST_CASE("every environment variable mcrt reads is read through one table and documented",
+          "[cli]") {
+    namespace fs = std::filesystem;
+    const fs::path root = MCRT_SOURCE_DIR;
+    auto text_of = [](const fs::path& p) {
+        std::ifstream in(p);
+        std::stringstream s;
+        s << in.rdbuf();
+        return s.str();
+    };
+    // The table is in enum order, one row per variable.
+    REQUIRE(mcrt::kEnvironment.size() == size_t(mcrt::kEnvironmentVariableCount));
+    for (size_t i = 0; i < mcrt::kEnvironment.size(); ++i) CHECK(size_t(mcrt::kEnvironment[i].id) == i);
+    // No source file reads the environment but common/environment.cpp.
+    for (const auto& entry : fs::recursive_directory_iterator(root / "host")) {
+        if (!entry.is_regular_file() || entry.path().filename() == "environment.cpp") continue;
+        INFO(entry.path().string());
+        CHECK(text_of(entry.path()).find("getenv(") == std::string::npos);
+    }
+    // docs/DESIGN.md has a line for each.
+    const std::string design = text_of(root / "docs" / "DESIGN.md");
+    for (const mcrt::EnvironmentEntry& e : mcrt::kEnvironment) {
+        INFO(e.name);
+        CHECK(design.find(std::string("`") + e.name + "`") != std::string::npos);
     }
 }

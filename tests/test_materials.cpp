@@ -91,7 +91,6 @@ Device& device() {
 }
 
 cl_float4 f4(const dvec3& v, float w = 0.0f) { return {{float(v.x), float(v.y), float(v.z), w}}; }
-cl_float4 f4(const gpu::float4& v) { return {{v.x, v.y, v.z, v.w}}; }
 dvec3 d3(const cl_float4& v) { return dvec3(v.s[0], v.s[1], v.s[2]); }
 
 dvec3 view_at(double theta_degrees) {

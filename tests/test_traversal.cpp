@@ -133,7 +133,7 @@ TEST_CASE("closest hit on the device agrees with brute force in double precision
         if (!device_hit) continue;
         ++hits_found;
         REQUIRE(leaf_index < bvh.triangles.size());
-        uint32_t scene_triangle = bits(bvh.triangles[leaf_index].p1.w);
+        uint32_t scene_triangle = bvh.triangles[leaf_index].index;
         CHECK(hits[k].x == Approx(ref).epsilon(1e-4));
         // Another triangle at the same distance (a tie) is as good an answer.
         if (int(scene_triangle) != ref_triangle) {

@@ -229,8 +229,8 @@ int run_bench(const BenchOptions& o, const std::function<void(const std::string&
                 r.embree.hits += embree_hit;
                 if (mcrt_hit != embree_hit) {
                     ++r.hit_mismatches;
-                } else if (mcrt_hit && gpu::as_uint(bvh.triangles[leaf].p1.w) != embree_triangle[k]) {
-                    ++r.triangle_mismatches;  // p1.w holds the scene's triangle index
+                } else if (mcrt_hit && bvh.triangles[leaf].index != embree_triangle[k]) {
+                    ++r.triangle_mismatches;
                     float t = primary_hits[k].x, te = embree_t[k];
                     if (std::abs(t - te) > kTieRelative * std::max(t, te))
                         ++r.triangle_mismatches_apart;

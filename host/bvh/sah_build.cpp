@@ -476,9 +476,11 @@ Bvh Builder::build() {
         const uint32_t t = ids_[i];
         const glm::vec3* p = &scene_.positions[3 * size_t(t)];
         gpu::Triangle& tri = bvh.triangles[i];
-        tri.p0 = {p[0].x, p[0].y, p[0].z, gpu::as_float(scene_.triangle_material[t])};
-        tri.p1 = {p[1].x, p[1].y, p[1].z, gpu::as_float(t)};
+        tri.p0 = {p[0].x, p[0].y, p[0].z, 0.0f};
+        tri.p1 = {p[1].x, p[1].y, p[1].z, 0.0f};
         tri.p2 = {p[2].x, p[2].y, p[2].z, 0.0f};
+        tri.material = scene_.triangle_material[t];
+        tri.index = t;
     }
     fill_stats(bvh, depth);
 

@@ -64,6 +64,9 @@ DeviceWorker::DeviceWorker(const DeviceContext& device, const GpuSceneData& scen
     report.name = device.info.name;
     report.index = device.info.index;
     const RenderSettings& settings = plan.settings;
+    if (scene.light_selection != plan.variants.light_select->id)
+        throw RuntimeError("the device scene holds the data of another light selection than " +
+                           settings.light_select + "'s");
 
     cl::Program program = render_program(device, plan);
     render_ = make_kernel(program, "render");

@@ -67,20 +67,15 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
         powers.push_back(e.power);
         light_of_triangle[e.triangle] = uint32_t(data.lights.size());
     }
-    data.light_selection = selection;
-    switch (selection) {
-        case LightSelection::Uniform: break;
-        case LightSelection::Power: data.light_cdf = build_cdf(powers); break;
-        case LightSelection::Alias: data.light_alias = build_alias_table(powers); break;
-        case LightSelection::Tree: data.light_tree = build_light_tree(data.lights, powers); break;
-    }
+    data.light_powers = std::move(powers);
+    build_light_selection(data, selection);
     // Shading's view of each packet lane (unused lanes stay zero: no ray hits them).
     data.triangle_info.assign(bvh.packets.size() * MCRT_PACKET_WIDTH, gpu::TriangleInfo{});
     for (size_t p = 0; p < bvh.packets.size(); ++p) {
         for (int lane = 0; lane < MCRT_PACKET_WIDTH; ++lane) {
             const uint32_t leaf = bvh.packets[p].index[lane];
             if (leaf == MCRT_NO_HIT) continue;
-            const uint32_t scene_triangle = gpu::as_uint(bvh.triangles[leaf].p1.w);
+            const uint32_t scene_triangle = bvh.triangles[leaf].index;
             gpu::TriangleInfo& info = data.triangle_info[p * MCRT_PACKET_WIDTH + size_t(lane)];
             info.material = scene.triangle_material[scene_triangle];
             info.light = light_of_triangle[scene_triangle];
@@ -88,6 +83,20 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
     }
     data.camera = make_gpu_camera(camera, width, height);
     return data;
+}
+
+void build_light_selection(GpuSceneData& data, LightSelection selection) {
+    data.light_selection = selection;
+    data.light_cdf.clear();
+    data.light_alias.clear();
+    data.light_tree = LightTree{};
+    const std::vector<double>& powers = data.light_powers;
+    switch (selection) {
+        case LightSelection::Uniform: break;
+        case LightSelection::Power: data.light_cdf = build_cdf(powers); break;
+        case LightSelection::Alias: data.light_alias = build_alias_table(powers); break;
+        case LightSelection::Tree: data.light_tree = build_light_tree(data.lights, powers); break;
+    }
 }
 
 std::vector<uint32_t> light_selection_words(const GpuSceneData& data, uint32_t* tree_nodes) {

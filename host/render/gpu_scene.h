@@ -26,6 +26,7 @@ struct GpuSceneData {
     // (lights + 1 entries, PBRT 3rd ed. 13.3.1), alias's table of the same distribution, or the
     // tree (render/light_tree.h); uniform has none.
     LightSelection light_selection = LightSelection::Power;
+    std::vector<double> light_powers;  // one per light: what every selection is built from
     std::vector<float> light_cdf;
     std::vector<gpu::AliasEntry> light_alias;
     LightTree light_tree;
@@ -42,6 +43,10 @@ gpu::CameraGpu make_gpu_camera(const Camera& camera, int width, int height);
 // `selection` alone; `camera` as chosen by the caller.
 GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& camera, int width,
                             int height, LightSelection selection = LightSelection::Power);
+
+// Replaces the light selection's data with that of `selection` (a device scene built for one
+// selection, rendered with another).
+void build_light_selection(GpuSceneData& data, LightSelection selection);
 
 // The light selection's buffer as the kernels read it (RENDER_ARG_LIGHT_SELECTION), in 32-bit
 // words; `tree_nodes` the nodes at its head for the tree, else 0.

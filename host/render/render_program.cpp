@@ -68,7 +68,7 @@ cl::Program render_program(const DeviceContext& device, const RenderPlan& plan) 
         std::string error =
             first_error_in(what.substr(what.find('\n') + 1), settings.estimator_file);
         if (error.empty()) throw;
-        throw InputError(error + " (--estimator-file; build log follows)\n" +
+        throw InputError(error + " (the estimator file; build log follows)\n" +
                          what.substr(what.find('\n') + 1));
     }
 }
@@ -77,21 +77,22 @@ std::string read_estimator_file(const std::string& path) {
     std::error_code ec;
     auto status = std::filesystem::status(path, ec);
     if (ec || !std::filesystem::exists(status))
-        throw InputError("--estimator-file " + path + ": no such file");
+        throw SettingError("estimator_file", path + ": no such file");
     if (!std::filesystem::is_regular_file(status))
-        throw InputError("--estimator-file " + path + ": not a regular file");
+        throw SettingError("estimator_file", path + ": not a regular file");
     std::ifstream in(path, std::ios::binary);
     std::ostringstream text;
     text << in.rdbuf();
-    if (!in) throw InputError("--estimator-file " + path + ": cannot read");
+    if (!in) throw SettingError("estimator_file", path + ": cannot read");
     // The kernel calls the user's function by name: say so before a compiler would, in mcrt's
     // own source, that it is missing.
     static const std::regex definition(std::string("\\b") + kUserEstimatorFunction + "\\s*\\(");
     if (!std::regex_search(text.str(), definition))
-        throw InputError("--estimator-file " + path + ": defines no function float3 " +
-                         kUserEstimatorFunction +
-                         "(const SceneView*, const SurfacePoint*, "
-                         "const SampleStream*, uint*) (docs/ESTIMATORS.md)");
+        throw SettingError("estimator_file", path + ": defines no function float3 " +
+                                                 kUserEstimatorFunction +
+                                                 "(const SceneView*, const SurfacePoint*, "
+                                                 "const SampleStream*, uint*) "
+                                                 "(docs/ESTIMATORS.md)");
     return text.str();
 }
 

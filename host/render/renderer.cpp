@@ -138,6 +138,12 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
                     const RenderControl& control,
                     const std::function<void(const std::string&)>& warn,
                     const RemoteWorkers& remote) {
+    if (scene.light_selection != plan.variants.light_select->id) {
+        // A device scene built for another light selection: its data for this one.
+        GpuSceneData rebuilt = scene;
+        build_light_selection(rebuilt, plan.variants.light_select->id);
+        return render(devices, rebuilt, plan, progress, control, warn, remote);
+    }
     auto start = std::chrono::steady_clock::now();
     const RenderSettings& settings = plan.settings;
     const uint32_t pixels = uint32_t(settings.width) * uint32_t(settings.height);
