@@ -51,7 +51,7 @@ RenderPlan check_render_settings(RenderSettings settings, const std::optional<gl
         settings.sky = *sky;
         settings.sky_light = v.uses(kUsesSkyLight) && (sky->r > 0 || sky->g > 0 || sky->b > 0);
     } else {
-        settings.sky = glm::vec3(v.uses(kUsesSky) ? 1.0f : 0.0f);
+        settings.sky = glm::vec3(v.ambient() ? 1.0f : 0.0f);
         settings.sky_light = false;
     }
     settings.replicates = replicates_for(settings.replicates, settings.spp, v);
