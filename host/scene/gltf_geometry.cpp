@@ -97,6 +97,10 @@ void merge_duplicate_emitters(Scene& scene, Diagnostics& diag) {
 
 }  // namespace
 
+void warn_morph_targets(Diagnostics& diag) {
+    diag.warn_once("morph", "morph targets are not supported; base geometry used");
+}
+
 GeometryImporter::GeometryImporter(const tinygltf::Model& model, Diagnostics& diag,
                                    MaterialTable& materials, Scene& scene)
     : model_(model), diag_(diag), materials_(materials), scene_(scene) {}
@@ -104,9 +108,7 @@ GeometryImporter::GeometryImporter(const tinygltf::Model& model, Diagnostics& di
 void GeometryImporter::add_primitive(const tinygltf::Primitive& primitive,
                                      const std::string& element, const glm::dmat4& world,
                                      const std::string& node_element) {
-    if (!primitive.targets.empty()) {
-        diag_.warn_once("morph", "morph targets are not supported; base geometry used");
-    }
+    if (!primitive.targets.empty()) warn_morph_targets(diag_);
     const int mode = primitive.mode == -1 ? TINYGLTF_MODE_TRIANGLES : primitive.mode;
     if (mode >= TINYGLTF_MODE_POINTS && mode <= TINYGLTF_MODE_LINE_STRIP) {
         diag_.warn_once("points-lines", "points and lines are not supported; skipped");

@@ -12,6 +12,9 @@
 
 namespace mcrt::gltf {
 
+// Morph targets (a node's weights, a primitive's targets) are ignored: one warning for both.
+void warn_morph_targets(Diagnostics& diag);
+
 // Appends each primitive's triangles, with their material slots, to `scene`, and keeps what the
 // whole scene is checked against once every primitive is in.
 class GeometryImporter {

@@ -18,16 +18,21 @@ namespace mcrt {
 
 namespace {
 
+// Skins and KHR_lights_punctual lights are ignored wherever a file holds them (the model or a
+// node): one warning each.
+void warn_skins(gltf::Diagnostics& diag) {
+    diag.warn_once("skins", "skins are not supported; meshes keep their bind pose");
+}
+void warn_lights(gltf::Diagnostics& diag) {
+    diag.warn_once("lights", "KHR_lights_punctual lights are not supported; ignored");
+}
+
 void warn_unsupported_model_parts(const tinygltf::Model& model, gltf::Diagnostics& diag) {
-    if (!model.lights.empty()) {
-        diag.warn_once("lights", "KHR_lights_punctual lights are not supported; ignored");
-    }
+    if (!model.lights.empty()) warn_lights(diag);
     if (!model.animations.empty()) {
         diag.warn_once("animations", "animations are not supported; the rest pose is used");
     }
-    if (!model.skins.empty()) {
-        diag.warn_once("skins", "skins are not supported; meshes keep their bind pose");
-    }
+    if (!model.skins.empty()) warn_skins(diag);
 }
 
 // The default scene of `model`, which was read from `path` (named in every message).
@@ -46,14 +51,9 @@ Scene import_default_scene(const tinygltf::Model& model, const std::string& path
     gltf::traverse(model, roots, diag, [&](int node_index, const glm::dmat4& world) {
         const tinygltf::Node& node = model.nodes[static_cast<size_t>(node_index)];
         const std::string element = gltf::element_name("node", static_cast<size_t>(node_index));
-        if (node.skin != -1)
-            diag.warn_once("skins", "skins are not supported; meshes keep their bind pose");
-        if (!node.weights.empty()) {
-            diag.warn_once("morph", "morph targets are not supported; base geometry used");
-        }
-        if (node.extensions.count("KHR_lights_punctual")) {
-            diag.warn_once("lights", "KHR_lights_punctual lights are not supported; ignored");
-        }
+        if (node.skin != -1) warn_skins(diag);
+        if (!node.weights.empty()) gltf::warn_morph_targets(diag);
+        if (node.extensions.count("KHR_lights_punctual")) warn_lights(diag);
         if (node.mesh != -1) {
             const tinygltf::Mesh& mesh =
                 gltf::checked_at(model.meshes, node.mesh, "mesh", element, diag);

@@ -12,6 +12,12 @@ namespace mcrt::gltf {
 
 namespace {
 
+// `values` are exactly `size` finite non-negative numbers.
+bool finite_non_negative(const std::vector<double>& values, size_t size) {
+    return values.size() == size && all_finite(values) &&
+           *std::min_element(values.begin(), values.end()) >= 0.0;
+}
+
 // A factor the specification bounds to [0, 1]: NaN and infinities fail, others are clamped
 // with one warning.
 float unit_factor(double value, const char* what, const std::string& element, Diagnostics& diag) {
@@ -135,13 +141,11 @@ Material MaterialTable::convert(int material_index, const std::string& referrer)
     warn_unsupported_parts(source, diag_);
 
     const std::vector<double>& base = source.pbrMetallicRoughness.baseColorFactor;
-    if (base.size() != 4 || !all_finite(base) ||
-        *std::min_element(base.begin(), base.end()) < 0.0) {
+    if (!finite_non_negative(base, 4)) {
         diag_.fail(element, "baseColorFactor must be 4 finite non-negative numbers");
     }
     const std::vector<double>& emissive = source.emissiveFactor;
-    if (!emissive.empty() && (emissive.size() != 3 || !all_finite(emissive) ||
-                              *std::min_element(emissive.begin(), emissive.end()) < 0.0)) {
+    if (!emissive.empty() && !finite_non_negative(emissive, 3)) {
         diag_.fail(element, "emissiveFactor must be 3 finite non-negative numbers");
     }
 

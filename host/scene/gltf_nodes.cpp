@@ -29,31 +29,27 @@ glm::dmat4 local_transform(const tinygltf::Model& model, int node_index, Diagnos
     check(node.rotation, 4, "rotation");
     check(node.scale, 3, "scale");
 
+    glm::dmat4 transform(1.0);
     if (!node.matrix.empty()) {
-        const glm::dmat4 m = glm::make_mat4(node.matrix.data());
+        transform = glm::make_mat4(node.matrix.data());
         // "Transformations": a matrix must decompose into T·R·S, so its last row is 0 0 0 1.
-        if (m[0][3] != 0.0 || m[1][3] != 0.0 || m[2][3] != 0.0 || m[3][3] != 1.0) {
+        if (transform[0][3] != 0.0 || transform[1][3] != 0.0 || transform[2][3] != 0.0 ||
+            transform[3][3] != 1.0) {
             diag.fail(element, "matrix is projective (its last row is not 0 0 0 1)");
         }
-        if (glm::determinant(glm::dmat3(m)) == 0.0) {
-            diag.warn_once("singular", element +
-                                           ": transform is singular (zero scale): its "
-                                           "geometry collapses and is degenerate");
+    } else {
+        if (!node.translation.empty())
+            transform = glm::translate(transform, glm::make_vec3(node.translation.data()));
+        if (!node.rotation.empty()) {
+            const auto& r = node.rotation;
+            const glm::dquat q(r[3], r[0], r[1], r[2]);  // glm takes w first
+            const double length = glm::length(q);
+            if (!(length > 0.0)) diag.fail(element, "rotation is a zero quaternion");
+            transform *= glm::mat4_cast(q / length);
         }
-        return m;
+        if (!node.scale.empty())
+            transform = glm::scale(transform, glm::make_vec3(node.scale.data()));
     }
-
-    glm::dmat4 transform(1.0);
-    if (!node.translation.empty())
-        transform = glm::translate(transform, glm::make_vec3(node.translation.data()));
-    if (!node.rotation.empty()) {
-        const auto& r = node.rotation;
-        const glm::dquat q(r[3], r[0], r[1], r[2]);  // glm takes w first
-        const double length = glm::length(q);
-        if (!(length > 0.0)) diag.fail(element, "rotation is a zero quaternion");
-        transform *= glm::mat4_cast(q / length);
-    }
-    if (!node.scale.empty()) transform = glm::scale(transform, glm::make_vec3(node.scale.data()));
     if (glm::determinant(glm::dmat3(transform)) == 0.0) {
         diag.warn_once("singular", element +
                                        ": transform is singular (zero scale): its "
