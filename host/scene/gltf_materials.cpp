@@ -1,0 +1,181 @@
+// glTF materials as mcrt's Material: the metallic-roughness factors (glTF 2.0 Appendix B),
+// emission with KHR_materials_emissive_strength, KHR_materials_specular; what is ignored warned.
+#include "scene/gltf_materials.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "common/value_limits.h"
+
+namespace mcrt::gltf {
+
+namespace {
+
+// `values` are exactly `size` finite non-negative numbers.
+bool finite_non_negative(const std::vector<double>& values, size_t size) {
+    return values.size() == size && all_finite(values) &&
+           *std::min_element(values.begin(), values.end()) >= 0.0;
+}
+
+// A factor the specification bounds to [0, 1]: NaN and infinities fail, others are clamped
+// with one warning.
+float unit_factor(double value, const char* what, const std::string& element, Diagnostics& diag) {
+    if (!std::isfinite(value)) diag.fail(element, std::string(what) + " must be a finite number");
+    if (value < 0.0 || value > 1.0) {
+        diag.warn_once(
+            std::string("factor-") + what,
+            element + ": " + what + " " + format_number(value) + " is outside [0, 1]; clamped");
+        value = std::clamp(value, 0.0, 1.0);
+    }
+    return float(value);
+}
+
+// glTF 2.0 Appendix B's parameters: metallicFactor, roughnessFactor (default 1 each), and
+// KHR_materials_specular's specularFactor (default 1) and specularColorFactor (default 1, 1, 1;
+// F0 = min(0.04 × it, 1) is clamped where the BRDF is built, host/render/gpu_scene.cpp).
+void read_microfacet_factors(const tinygltf::Material& source, const std::string& element,
+                             Diagnostics& diag, Material& material) {
+    const auto& pbr = source.pbrMetallicRoughness;
+    material.metallic = unit_factor(pbr.metallicFactor, "metallicFactor", element, diag);
+    material.roughness = unit_factor(pbr.roughnessFactor, "roughnessFactor", element, diag);
+    material.specular = 1.0f;
+    material.specular_color = glm::vec3(1.0f);
+    const auto extension = source.extensions.find("KHR_materials_specular");
+    if (extension == source.extensions.end() || !extension->second.IsObject()) return;
+    const tinygltf::Value& ext = extension->second;
+    if (ext.Has("specularFactor")) {
+        const tinygltf::Value& v = ext.Get("specularFactor");
+        material.specular = unit_factor(
+            v.IsNumber() ? v.GetNumberAsDouble() : std::numeric_limits<double>::quiet_NaN(),
+            "KHR_materials_specular.specularFactor", element, diag);
+    }
+    if (ext.Has("specularColorFactor")) {
+        const tinygltf::Value& v = ext.Get("specularColorFactor");
+        bool ok = v.IsArray() && v.ArrayLen() == 3;
+        glm::dvec3 c(0.0);
+        for (int k = 0; ok && k < 3; ++k) {
+            ok = v.Get(k).IsNumber();
+            if (ok) c[k] = v.Get(k).GetNumberAsDouble();
+            ok = ok && std::isfinite(c[k]) && c[k] >= 0.0 && c[k] <= 1e30;
+        }
+        if (!ok) {
+            diag.fail(element,
+                      "KHR_materials_specular.specularColorFactor must be 3 finite "
+                      "non-negative numbers");
+        }
+        material.specular_color = glm::vec3(c);
+    }
+}
+
+// KHR_materials_emissive_strength: a non-negative multiplier of emissiveFactor, 1 when absent.
+double emissive_strength(const tinygltf::Material& material, const std::string& element,
+                         const Diagnostics& diag) {
+    const auto extension = material.extensions.find("KHR_materials_emissive_strength");
+    if (extension == material.extensions.end()) return 1.0;
+    if (!extension->second.IsObject() || !extension->second.Has("emissiveStrength")) return 1.0;
+    const tinygltf::Value& value = extension->second.Get("emissiveStrength");
+    const double strength =
+        value.IsNumber() ? value.GetNumberAsDouble() : std::numeric_limits<double>::quiet_NaN();
+    if (!(strength >= 0.0) || !std::isfinite(strength)) {
+        diag.fail(element,
+                  "KHR_materials_emissive_strength.emissiveStrength must be a finite "
+                  "non-negative number");
+    }
+    return strength;
+}
+
+// What of a material mcrt does not render, once per kind.
+void warn_unsupported_parts(const tinygltf::Material& material, Diagnostics& diag) {
+    const auto& pbr = material.pbrMetallicRoughness;
+    if (pbr.baseColorTexture.index != -1 || pbr.metallicRoughnessTexture.index != -1 ||
+        material.normalTexture.index != -1 || material.occlusionTexture.index != -1 ||
+        material.emissiveTexture.index != -1) {
+        diag.warn_once("textures", "textures are not supported; material factors used alone");
+    }
+    if (material.alphaMode != "OPAQUE") {
+        diag.warn_once(
+            "alpha", "alphaMode " + material.alphaMode + " is not supported; surfaces are opaque");
+    }
+    if (material.extensions.count("KHR_materials_transmission")) {
+        diag.warn_once("transmission",
+                       "KHR_materials_transmission is not supported; surfaces are opaque "
+                       "(reflection only)");
+    }
+}
+
+}  // namespace
+
+MaterialTable::MaterialTable(const tinygltf::Model& model, Diagnostics& diag,
+                             std::vector<Material>& materials)
+    : model_(model), diag_(diag), materials_(materials) {}
+
+uint32_t MaterialTable::slot(int material_index, const std::string& referrer) {
+    const auto found = slots_.find(material_index);
+    if (found != slots_.end()) return found->second;
+
+    Material material;
+    if (material_index == -1) {
+        // "Materials": the default material is white, not emissive, single-sided, with the
+        // metallic-roughness defaults (metallic 1, roughness 1) and the specular layer of
+        // KHR_materials_specular's defaults.
+        material.name = "default";
+        material.metallic = 1.0f;
+        material.roughness = 1.0f;
+        material.specular = 1.0f;
+    } else {
+        material = convert(material_index, referrer);
+    }
+    const uint32_t index = static_cast<uint32_t>(materials_.size());
+    materials_.push_back(material);
+    slots_.emplace(material_index, index);
+    return index;
+}
+
+// DESIGN.md "Radiometric contract": albedo = baseColorFactor.rgb,
+// Le = emissiveFactor × KHR_materials_emissive_strength.emissiveStrength.
+Material MaterialTable::convert(int material_index, const std::string& referrer) {
+    const tinygltf::Material& source =
+        checked_at(model_.materials, material_index, "material", referrer, diag_);
+    const std::string element = element_name("material", static_cast<size_t>(material_index));
+    warn_unsupported_parts(source, diag_);
+
+    const std::vector<double>& base = source.pbrMetallicRoughness.baseColorFactor;
+    if (!finite_non_negative(base, 4)) {
+        diag_.fail(element, "baseColorFactor must be 4 finite non-negative numbers");
+    }
+    const std::vector<double>& emissive = source.emissiveFactor;
+    if (!emissive.empty() && !finite_non_negative(emissive, 3)) {
+        diag_.fail(element, "emissiveFactor must be 3 finite non-negative numbers");
+    }
+
+    Material material;
+    material.name = source.name.empty() ? element : source.name;
+    glm::dvec3 albedo(base[0], base[1], base[2]);
+    if (max_component(albedo) > 1.0) {
+        // An albedo above 1 reflects more than arrives: energy from nothing.
+        diag_.warn_once("albedo", element + ": baseColorFactor " +
+                                      format_number(max_component(albedo)) +
+                                      " is above 1; factors are clamped to [0, 1]");
+        albedo = glm::min(albedo, glm::dvec3(1.0));
+    }
+    material.albedo = glm::vec3(albedo);
+    if (!emissive.empty()) {
+        const glm::dvec3 Le = glm::dvec3(emissive[0], emissive[1], emissive[2]) *
+                              emissive_strength(source, element, diag_);
+        material.emission = glm::vec3(Le);
+        if (!is_finite(glm::dvec3(material.emission))) {
+            diag_.fail(element, "emission overflows single precision");
+        }
+        if (max_component(Le) > kMaxRadiance) {
+            diag_.fail(element, "emission " + format_number(max_component(Le)) + " exceeds " +
+                                    format_number(kMaxRadiance) +
+                                    ", beyond which an estimate may overflow single precision");
+        }
+    }
+    material.double_sided = source.doubleSided;
+    read_microfacet_factors(source, element, diag_, material);
+    return material;
+}
+
+}  // namespace mcrt::gltf

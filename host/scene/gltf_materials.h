@@ -1,0 +1,38 @@
+// The glTF materials a scene uses, converted to mcrt's Material (DESIGN.md "Radiometric
+// contract"); textures, alpha and transmission are warned about and ignored.
+#pragma once
+
+#include <tiny_gltf.h>
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "scene/gltf_diagnostics.h"
+#include "scene/scene.h"
+
+namespace mcrt::gltf {
+
+// Each glTF material converted once, when a primitive first uses it: slots follow first use, and
+// a material's errors name the primitive that first refers to it.
+class MaterialTable {
+  public:
+    // Converted materials are appended to `materials` (the Scene's).
+    MaterialTable(const tinygltf::Model& model, Diagnostics& diag,
+                  std::vector<Material>& materials);
+
+    // The slot in `materials` of glTF material `material_index` (−1: the default material);
+    // `referrer` names the element that refers to it.
+    uint32_t slot(int material_index, const std::string& referrer);
+
+  private:
+    Material convert(int material_index, const std::string& referrer);
+
+    const tinygltf::Model& model_;
+    Diagnostics& diag_;
+    std::vector<Material>& materials_;
+    std::map<int, uint32_t> slots_;  // glTF material index (−1: default) → slot
+};
+
+}  // namespace mcrt::gltf
