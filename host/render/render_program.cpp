@@ -56,7 +56,7 @@ std::string render_program_options(const RenderSettings& settings, bool microfac
         option_variant(kMaterialVariants, settings.materials, "--materials");
     if (microfacet && materials.macro) options += std::string(" -D ") + materials.macro;
     // Development override, as MCRT_KERNEL_DIR is for the sources: extra build options, e.g.
-    // the -D switches of scripts/bench/profile_stages.py (docs/BENCHMARKS.md, issue 16).
+    // the -D switches of scripts/bench/profile_stages.py (docs/BENCHMARKS.md, "Where a sample's time goes").
     if (const char* extra = std::getenv("MCRT_KERNEL_OPTIONS"); extra && *extra)
         options += std::string(" ") + extra;
     return options;

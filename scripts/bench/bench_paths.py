@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Path-tracing throughput: mcrt against Mitsuba 3's `path` integrator at the same depth, in one
-run on the same machine (docs/BENCHMARKS.md, issue 15).
+run on the same machine (docs/BENCHMARKS.md, "Path tracing against Mitsuba 3's path integrator").
 
 For each scene: `mcrt render --max-depth N` (mis, power, independent) — samples and rays per
 second of kernel time from its stats — and scripts/tools/mitsuba_reference.py --max-depth N (Mitsuba's

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """mcrt against Mitsuba 3's llvm_ad_rgb variant, estimator for estimator: the same scene, image
-size, spp and estimator, in alternating rounds on the same machine (issue 16).
+size, spp and estimator, in alternating rounds on the same machine (docs/BENCHMARKS.md, "Against Mitsuba 3's LLVM variant").
 
 Pairs (--pairs; mcrt always with --materials lambert --light-select power --sampler
 independent, as Mitsuba's scene is mitsuba_reference.py's diffuse conversion):
@@ -196,7 +196,7 @@ def bench(args, mi, item, pair, scratch):
     rounds, mcrt_images, mitsuba_images = [], Accumulator(), Accumulator()
     # Each pair its own seeds: with the same seeds 0 .. R−1 everywhere, the pairs of a scene
     # drew the same random numbers (common random numbers), and their image means' differences
-    # were one draw shown six times (docs/BENCHMARKS.md, session 6).
+    # were one draw shown six times (docs/BENCHMARKS.md, "Against Mitsuba 3's LLVM variant").
     first_seed = PAIRS.index(pair) * args.rounds
     for r in range(args.rounds):
         seed = first_seed + r

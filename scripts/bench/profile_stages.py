@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Where a sample's time goes: the render kernel with one stage left out at a time, against the
-whole, in alternating rounds (docs/BENCHMARKS.md, "Where a sample's time goes", issue 16).
+whole, in alternating rounds (docs/BENCHMARKS.md, "Where a sample's time goes").
 
 Each stage is a textual change of a copy of kernels/ (read through MCRT_KERNEL_DIR), checked to
 apply exactly once, so that a kernel edit which moves a stage's code fails loudly here instead of

@@ -19,7 +19,7 @@ every row (`reference_rmse_floor`) and drawn as a floor on the charts.
 Reference (--reference auto): the lowest-variance estimator mcrt has for direct light, `mis`
 with `power` light selection and the `sobol` sampler, at --reference-spp (default 4096) spp, as
 two half renders with different seeds averaged. Its noise floor is its variance layer, honest
-for Sobol samples since it comes from independent replicates (issue 13; the two halves'
+for Sobol samples since it comes from independent replicates (docs/EXPERIMENTS.md, "The variance layer"; the two halves'
 E[(a − b)²]/4 is kept beside it as a cross-check). Every row's `layer_rmse` is the render's own
 error bar the same way (√ of its variance layer's mean, bias excluded): error bars for every
 sampler, from one render. It is cached in
@@ -171,7 +171,7 @@ def auto_reference(args, scene, scratch):
         # sqrt of the variance layer per pixel, averaged: the per-pixel standard error
         "standard_error_layer": float(np.mean(np.sqrt(variance))),
         # the floor used: the reference's RMSE from its variance layers, honest for Sobol
-        # samples since they come from replicates (issue 13)
+        # samples since they come from replicates
         "rmse_floor_layer": math.sqrt(layer_mse),
         "rmse_floor": math.sqrt(layer_mse),
         "relrmse_floor": math.sqrt(layer_relmse),

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Light that bounces: error against time of every direct estimator used as next-event
-estimation inside the path tracer, at several depths (docs/EXPERIMENTS.md, issue 15).
+estimation inside the path tracer, at several depths (docs/EXPERIMENTS.md, "Paths: every direct estimator as next-event estimation").
 
 For each scene and each depth (`N` or `N:K` for --max-depth N --rr-depth K), runs
 scripts/experiments/experiment.py (its auto reference at that depth: mis, power, sobol), then prints one

@@ -4,7 +4,7 @@
   variance.exr / .png     the variance layer of the render at the largest spp (the variance of
                           each pixel mean, mean of R, G, B; also per channel in the EXR):
                           honest for every sampler, from independent replicates with stratified
-                          and Sobol samples (issue 13), so it maps where the error really is;
+                          and Sobol samples, so it maps where the error really is;
                           false colour of log10;
   convergence.exr / .png  per pixel, the slope of log MSE against log spp, fitted over renders
                           at every --spp level (MSE: squared error against the reference, mean
