@@ -1,7 +1,7 @@
 /* BVH traversal over 4-wide nodes (Bvh4Node): closest hit for camera rays, any hit for shadow
  * rays. One slab test in float4 arithmetic covers a node's four children, one watertight test in
  * float4 arithmetic a leaf's packet of four triangles: PoCL runs each ray as scalar code, so SIMD
- * comes only from explicit vector types (docs/BENCHMARKS.md, issue 6: the node gave up to 1.5×
+ * comes only from explicit vector types (docs/BENCHMARKS.md, "Ray traversal": the node gave up to 1.5×
  * over a BVH2, the packets 1.3–1.4× more on the large scenes). */
 #ifndef MCRT_BVH_TRAVERSE_CL
 #define MCRT_BVH_TRAVERSE_CL
@@ -117,7 +117,7 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
                  * visit rank is the number of entered children before it in that order, found
                  * by compares against the rotated distances (a sorting network without
                  * branches or private arrays: the insertion sort it replaces mispredicted on
-                 * every node, docs/BENCHMARKS.md, issue 16). Non-entered children are at
+                 * every node, docs/BENCHMARKS.md, "Render throughput: kernel changes measured"). Non-entered children are at
                  * MAXFLOAT, after every entered one. */
                 float4 r1 = t4.yzwx, r2 = t4.zwxy, r3 = t4.wxyz;
                 int4 before1 = (r1 < t4) | ((r1 == t4) & (int4)(-1, -1, -1, 0));
@@ -206,7 +206,7 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePa
  * entered (any hit ends the search); inner children go on the stack. Slots are taken from the
  * last to the first, so that slot 0 (the binary tree's leftmost child) is popped first: on the
  * bench's shadow rays this visited 6.7 nodes per ray in Sponza against 9.7 in slot order and 9.0
- * nearest first, but 8.3 against 5.5 in the modern hall (docs/BENCHMARKS.md, issue 6). No order
+ * nearest first, but 8.3 against 5.5 in the modern hall (docs/BENCHMARKS.md, "Ray traversal"). No order
  * wins everywhere; this one gave the best worst-case ratio to Embree over the bench scenes. */
 inline bool bvh_any_hit(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                         const Ray* r, float t_max, uint skip) {

@@ -85,7 +85,7 @@ inline float independent_1d(uint pixel, uint sample, uint dim, uint seed) {
 
 /* Two independent uniform numbers for the pair (dim, dim + 1): the first two of the four words of
  * one pcg4d(pixel, sample, dim, seed), whose outputs are independent of each other (Jarzynski &
- * Olano 2020 test all four): one hash for a 2D sample instead of two (issue 16). The first is
+ * Olano 2020 test all four): one hash for a 2D sample instead of two. The first is
  * independent_1d of dim; the second is not that of dim + 1, and nothing reads both. */
 inline float2 independent_2d(uint pixel, uint sample, uint dim, uint seed) {
     uint4 h = pcg4d((uint4)(pixel, sample, dim, seed));
@@ -193,7 +193,7 @@ inline uint sobol_dimension_1_reversed(uint index) {
 
 /* The three seeds of a pair's scrambles, per (pixel, dimension, replicate): y shuffles the sample
  * index (as pixel_dimension_key), z and w scramble the two coordinates; three words of one hash,
- * not three hashes (issue 16). */
+ * not three hashes. */
 inline uint4 sobol_keys(const SampleStream* s, uint dim) {
     return pcg4d((uint4)(s->pixel, 0xffffffffu, dim, replicate_seed(s)));
 }
@@ -202,7 +202,7 @@ inline uint4 sobol_keys(const SampleStream* s, uint dim) {
  * with an independent scramble for each pair (Burley 2020, sec. 4). The coordinates are
  * nested_uniform_scramble(reverse_bits(index)) and nested_uniform_scramble(sobol_dimension_1(
  * index)), written without the bit reversals that cancel (reverse_bits is an involution): 3
- * reversals per pair instead of 6, the same bits (issue 16). */
+ * reversals per pair instead of 6, the same bits. */
 inline float2 sampler_2d(const SampleStream* s, uint dim) {
     uint4 key = sobol_keys(s, dim);
     uint index = nested_uniform_scramble(s->sample, key.y);

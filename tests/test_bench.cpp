@@ -88,7 +88,7 @@ TEST_CASE("bench --json prints one consistent line per ray kind", "[bench]") {
     CHECK(lines["ambient"]["count"] == 4 * primary_hits);
 
 #ifdef MCRT_HAVE_EMBREE
-    // Embree's single-ray intersector is not watertight: allow 1 in 10,000 (issue 6).
+    // Embree's single-ray intersector is not watertight: allow 1 in 10,000.
     long long count = lines["primary"]["count"];
     long long mismatches = lines["primary"]["hit_mismatches"];
     CHECK(mismatches <= count / 10000 + 2);

@@ -1,4 +1,4 @@
-// The experiment harness (scripts/experiment.py) in its quick mode, end to end: on the Cornell
+// The experiment harness (scripts/experiments/experiment.py) in its quick mode, end to end: on the Cornell
 // box (one small light) it writes results.csv with a row per (configuration, spp), the four
 // charts, and ranks light-area above hemisphere-cosine in efficiency, while the error of every
 // configuration falls as spp grows. Skipped when Debian's python3 with numpy and matplotlib is
@@ -23,7 +23,7 @@ namespace {
 const char* kPython = "/usr/bin/python3";
 
 std::string script_path() {
-    return (std::filesystem::path(MCRT_SCENES).parent_path() / "scripts" / "experiment.py").string();
+    return (std::filesystem::path(MCRT_SCENES).parent_path() / "scripts" / "experiments" / "experiment.py").string();
 }
 
 void require_python_modules(const std::filesystem::path& scratch) {

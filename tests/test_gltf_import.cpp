@@ -1,6 +1,6 @@
 // glTF import (host/scene/gltf_import.cpp) and the scene queries (host/scene/scene.cpp):
 // the Khronos samples, the project's test scenes, hand-made broken files (tests/data, written by
-// scripts/make_test_gltf.py) and files from tinygltf's own robustness set.
+// scripts/scenes/make_test_gltf.py) and files from tinygltf's own robustness set.
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -274,7 +274,7 @@ TEST_CASE("tinygltf robustness files either load or throw InputError", "[gltf][r
 }
 
 // ---------------------------------------------------------------------------------------------
-// Hand-made files (tests/data, scripts/make_test_gltf.py)
+// Hand-made files (tests/data, scripts/scenes/make_test_gltf.py)
 // ---------------------------------------------------------------------------------------------
 
 TEST_CASE("Broken files throw InputError naming the file and the element", "[gltf][invalid]") {

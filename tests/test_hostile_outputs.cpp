@@ -1,4 +1,4 @@
-// Outputs that destroy, signals and pipes, images too large (issue 12, classes 1, 5 and 6): no
+// Outputs that destroy, signals and pipes, images too large (docs/ROBUSTNESS.md, "Hostile input"): no
 // output path is replaced unless it is a regular file that is no other output and no input, no
 // temporary file survives any way the process can end, and a closed stderr pipe or a late
 // SIGTERM does not lose the image. The tests never point an output at a system file: FIFOs,

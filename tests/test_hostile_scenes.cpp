@@ -1,6 +1,6 @@
-// Scenes that hang or crash the loader, values that overflow, silently wrong input (issue 12,
-// classes 2, 3 and 4). Each refusal is one InputError (exit 2 from mcrt render) naming the
-// cause; what is accepted with a warning warns once. Cases that hung or crashed the old loader
+// Scenes that hang or crash the loader, values that overflow, silently wrong input
+// (docs/ROBUSTNESS.md, "Hostile input"). Each refusal is one InputError (exit 2 from mcrt
+// render) naming the cause; what is accepted with a warning warns once. Cases that hung or crashed the old loader
 // run through the mcrt executable, so that a regression fails the test instead of hanging it.
 #include <sys/stat.h>
 

@@ -32,7 +32,7 @@ void check_close(const Renders& r, glm::dvec3 exact, const std::string& what) {
         CHECK(std::abs(r.mean[c] - exact[c]) <= 4.5 * r.standard_error[c] + 2e-5 * exact[c]);
 }
 
-// The estimators the issue names for the furnace, and those that see the sky light.
+// The estimators checked on the furnace, and those that see the sky light.
 std::vector<EstimatorCase> path_cases(std::initializer_list<const char*> names) {
     std::vector<EstimatorCase> cases;
     for (const EstimatorCase& c : estimator_cases(kUsesLights | kUsesSkyLight))

@@ -1,4 +1,4 @@
-// Stability where methods fail: the scenes of scenes/stress (scripts/make_stress_scenes.py) ×
+// Stability where methods fail: the scenes of scenes/stress (scripts/scenes/make_stress_scenes.py) ×
 // every estimator × light selection render without NaN or Inf, and wherever an estimator's
 // standard error means something on them, its image mean matches the exact image (Lambert's
 // formula for every emitting triangle; the scenes have no occluders) within 4.5 standard errors

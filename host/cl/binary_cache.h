@@ -1,5 +1,5 @@
 // An on-disk cache of compiled program binaries, so a second start skips compilation on drivers
-// that do not cache kernels themselves (issue 5, item 5).
+// that do not cache kernels themselves (docs/BENCHMARKS.md, "Kernel build and start-up").
 //
 // Entries live in $MCRT_CACHE_DIR if set, else $XDG_CACHE_HOME/mcrt/kernels, else
 // $HOME/.cache/mcrt/kernels; MCRT_NO_KERNEL_CACHE=1 turns the cache off. One file per key,

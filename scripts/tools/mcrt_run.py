@@ -1,0 +1,271 @@
+"""What every script needs of mcrt, once: the interpreter check, the default binary, running
+`mcrt render` and reading its EXR and stats, and the table of variants (`mcrt variants --json`).
+
+    import mcrt_run
+    mcrt_run.require("numpy")            # first, before importing numpy (see require)
+    import numpy as np
+    table = mcrt_run.variants()          # estimators, light selections, samplers, heuristics
+    r = mcrt_run.render(scene, stem, ["--estimator", "mis", "--spp", "64"])
+    r.rgb, r.variance, r.stats, r.wall_seconds
+
+Also: estimator_arguments / estimator_label / uses_light_select / check_estimators for built-in
+names and users' FILE.cl alike; read_image_file (an EXR as (3, H, W) arrays); comma_list,
+image_size, add_mcrt_option, check_choices for command lines; pyplot and save_png for charts.
+Scripts that only read the stats JSON (render(..., read_image=False)) need no numpy.
+
+Errors are raised as ScriptError (one line, naming the command); `script_main` turns them into
+one `NAME: error: ...` line and exit status 2, so no script prints a traceback for them.
+"""
+
+import functools
+import importlib.util
+import json
+import os
+import shlex
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]  # scripts/tools/ → the repository
+SYSTEM_PYTHON = "/usr/bin/python3"  # Debian's, with python3-numpy and python3-matplotlib
+
+
+class ScriptError(Exception):
+    """A failure worth one line: a command that failed, a missing file or binary."""
+
+
+def require(*modules):
+    """Makes sure this interpreter can import `modules` (e.g. numpy). When it cannot (a pyenv
+    or a venv first on PATH) and Debian's /usr/bin/python3 can, the script is run again under
+    that one; otherwise the process ends with one line saying which interpreter to use. The one
+    place this module ends the process: nothing else can run without those modules."""
+    missing = [m for m in modules if importlib.util.find_spec(m) is None]
+    if not missing:
+        return
+    script = os.path.abspath(sys.argv[0])
+    here = os.path.realpath(sys.executable or "")
+    if (os.path.exists(SYSTEM_PYTHON) and here != os.path.realpath(SYSTEM_PYTHON)
+            and not os.environ.get("MCRT_SCRIPT_REEXEC")):
+        os.environ["MCRT_SCRIPT_REEXEC"] = "1"
+        os.execv(SYSTEM_PYTHON, [SYSTEM_PYTHON, script] + sys.argv[1:])
+    print("%s: error: this Python (%s) lacks %s; run it with %s and Debian's "
+          "python3-numpy / python3-matplotlib (scripts/setup installs them)"
+          % (os.path.basename(script), sys.executable, ", ".join(missing), SYSTEM_PYTHON),
+          file=sys.stderr)
+    raise SystemExit(2)  # as script_main's one line
+
+
+def script_main(main):
+    """Runs main() and returns its exit status; a ScriptError becomes one line and status 2."""
+    name = os.path.basename(sys.argv[0])
+    try:
+        return main() or 0
+    except ScriptError as e:
+        print("%s: error: %s" % (name, e), file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("%s: interrupted" % name, file=sys.stderr)
+        return 130
+
+
+def default_mcrt():
+    """$MCRT, else build/mcrt of this checkout."""
+    return os.environ.get("MCRT") or str(ROOT / "build" / "mcrt")
+
+
+def mcrt_binary(path=None):
+    """The mcrt executable to run: `path`, or default_mcrt(); ScriptError when it is missing."""
+    path = path or default_mcrt()
+    if not (os.path.isfile(path) and os.access(path, os.X_OK)):
+        raise ScriptError("%s is not an executable: build mcrt first (scripts/setup)" % path)
+    return path
+
+
+def run(command, env=None):
+    """Runs a command, returning its CompletedProcess (text); ScriptError when it fails."""
+    full_env = dict(os.environ, **env) if env else None
+    try:
+        done = subprocess.run([str(c) for c in command], capture_output=True, text=True,
+                              env=full_env)
+    except OSError as e:
+        raise ScriptError("%s: %s" % (shlex.join(map(str, command)), e))
+    if done.returncode != 0:
+        # mcrt's own "mcrt: error:" line, not what a kernel compiler printed before it
+        lines = [l for l in done.stderr.strip().splitlines() if l.strip()]
+        ours = [l for l in lines if l.startswith("mcrt: error:")]
+        raise ScriptError("%s exited %d: %s" % (shlex.join(map(str, command)), done.returncode,
+                                                (ours or lines or ["(no message)"])[0]))
+    return done
+
+
+@functools.lru_cache(maxsize=None)
+def variants(mcrt=None):
+    """The table of variants of `mcrt variants --json`: {"estimators": [{name, function, uses,
+    description}], "light_select": [...], "samplers": [...], "mis_heuristics": [...]}."""
+    return json.loads(run([mcrt_binary(mcrt), "variants", "--json"]).stdout)
+
+
+def names(table, uses=None, mcrt=None):
+    """Names of one table of variants ("estimators", "light_select", "samplers",
+    "mis_heuristics"); for estimators, only those whose uses include `uses` when given."""
+    rows = variants(mcrt)[table]
+    return [r["name"] for r in rows if uses is None or uses in r.get("uses", [])]
+
+
+def is_estimator_file(estimator):
+    """True when `estimator` names a user's estimator file rather than a built-in."""
+    return estimator.endswith(".cl")
+
+
+def estimator_arguments(estimator):
+    """The render options that choose `estimator`: a built-in name or a user's .cl file."""
+    if is_estimator_file(estimator):
+        if not os.path.isfile(estimator):
+            raise ScriptError("estimator file %s does not exist" % estimator)
+        return ["--estimator-file", estimator]
+    return ["--estimator", estimator]
+
+
+def estimator_uses(estimator, mcrt=None):
+    """What an estimator uses ("lights", "sky", "mis-heuristic", "bsdf-sampling")."""
+    table = variants(mcrt)
+    if is_estimator_file(estimator):
+        return table["user_estimator"]["uses"]
+    for row in table["estimators"]:
+        if row["name"] == estimator:
+            return row["uses"]
+    raise ScriptError("unknown estimator %s (one of %s, or a file FILE.cl)"
+                      % (estimator, ", ".join(r["name"] for r in table["estimators"])))
+
+
+def uses_light_select(estimator, mcrt=None):
+    """True when --light-select changes what `estimator` computes: its uses include
+    "light-selection" (a user's file is assumed to, as the table's user_estimator row says)."""
+    return "light-selection" in estimator_uses(estimator, mcrt)
+
+
+def check_estimators(estimators, mcrt=None):
+    """ScriptError unless each is a built-in estimator or an existing .cl file, and their
+    labels (estimator_label) are distinct."""
+    labels = {}
+    for e in estimators:
+        estimator_arguments(e)  # a missing file
+        estimator_uses(e, mcrt)  # an unknown name
+        label = estimator_label(e)
+        if label in labels and labels[label] != e:
+            raise ScriptError("%s and %s would both be labelled %s: rename one" % (
+                labels[label], e, label))
+        labels[label] = e
+
+
+def estimator_label(estimator):
+    """A short name for charts: a file's stem, or the built-in name."""
+    return Path(estimator).stem if is_estimator_file(estimator) else estimator
+
+
+class Render:
+    """One finished render: rgb and variance as (3, H, W) float64, its stats JSON, wall time."""
+
+    def __init__(self, rgb, variance, stats, wall_seconds, command):
+        self.rgb, self.variance, self.stats = rgb, variance, stats
+        self.wall_seconds, self.command = wall_seconds, command
+
+
+def render(scene, stem, options, mcrt=None, env=None, read_image=True):
+    """`mcrt render SCENE --out STEM.exr --stats STEM.json --quiet OPTIONS`; returns a Render
+    (rgb and variance None when not `read_image`: then numpy is not needed)."""
+    stem = str(stem)
+    command = [mcrt_binary(mcrt), "render", str(scene), "--out", stem + ".exr",
+               "--stats", stem + ".json", "--quiet"] + [str(o) for o in options]
+    start = time.monotonic()
+    run(command, env)
+    wall = time.monotonic() - start
+    stats = json.loads(Path(stem + ".json").read_text())
+    if not read_image:
+        return Render(None, None, stats, wall, command)
+    rgb, variance = read_image_file(stem + ".exr")
+    return Render(rgb, variance, stats, wall, command)
+
+
+def read_image_file(path):
+    """(rgb, variance) of an EXR as (3, H, W) float64 arrays; variance None when the file has no
+    variance.R/G/B layer. ScriptError when it cannot be read."""
+    import numpy as np
+    from mcrt_exr import read_exr
+
+    try:
+        exr = read_exr(path)
+    except (OSError, ValueError, KeyError) as e:
+        raise ScriptError("cannot read %s: %s" % (path, e))
+    if not all(c in exr for c in "RGB"):
+        raise ScriptError("%s has no R, G, B channels" % path)
+    rgb = np.stack([exr[c] for c in "RGB"]).astype(np.float64)
+    variance = None
+    if all("variance." + c in exr for c in "RGB"):
+        variance = np.stack([exr["variance." + c] for c in "RGB"]).astype(np.float64)
+    return rgb, variance
+
+
+def remove_outputs(stem):
+    """Deletes STEM.exr and STEM.json of a render."""
+    for suffix in (".exr", ".json"):
+        Path(str(stem) + suffix).unlink(missing_ok=True)
+
+
+# ----- command-line helpers --------------------------------------------------------------------
+
+def comma_list(text):
+    """'a,b,,c' → ['a', 'b', 'c']."""
+    return [t for t in text.split(",") if t]
+
+
+def image_size(text):
+    """'WxH' → (W, H); an argparse type."""
+    import argparse
+
+    try:
+        width, height = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError("expected WIDTHxHEIGHT, e.g. 64x64: %r" % text)
+    if width <= 0 or height <= 0:
+        raise argparse.ArgumentTypeError("expected a positive size: %r" % text)
+    return width, height
+
+
+def add_mcrt_option(parser):
+    """--mcrt BINARY, default default_mcrt()."""
+    parser.add_argument("--mcrt", default=default_mcrt(),
+                        help="mcrt executable (default $MCRT, else build/mcrt)")
+
+
+def check_choices(kind, given, table, mcrt=None):
+    """ScriptError unless every name of `given` is one of the names of `table`, e.g.
+    check_choices("sampler", ["sobol"], "samplers")."""
+    known = names(table, mcrt=mcrt)
+    for name in given:
+        if name not in known:
+            raise ScriptError("unknown %s %s (one of %s)" % (kind, name, ", ".join(known)))
+
+
+# ----- charts ----------------------------------------------------------------------------------
+
+def pyplot():
+    """matplotlib.pyplot on the Agg backend (files only, no display)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def save_png(fig, path):
+    """Saves a figure as a small PNG: reduced to a 256-colour palette when Pillow is there."""
+    import io
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png")
+    try:
+        from PIL import Image
+        image = Image.open(io.BytesIO(buffer.getvalue())).convert("RGB")
+        image.quantize(256, method=Image.Quantize.MEDIANCUT).save(path, optimize=True)
+    except (ImportError, AttributeError):
+        Path(path).write_bytes(buffer.getvalue())
