@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
     const char* names[] = {"slab_group", "slab_barrier", "slab_float4"};
     const int kernels = 3;
     std::vector<double> ns[kernels];
-    for (int r = 0; r <= rounds; ++r) {  // round 0 warms up
+    for (int r = 0; r <= rounds; ++r) {  // r = 0 warms up
         for (int k = 0; k < kernels; ++k) {
             cl::Kernel kernel(program, names[k]);
             kernel.setArg(0, b_nodes);
