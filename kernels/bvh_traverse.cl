@@ -117,7 +117,7 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
                  * visit rank is the number of entered children before it in that order, found
                  * by compares against the rotated distances (a sorting network without
                  * branches or private arrays: the insertion sort it replaces mispredicted on
-                 * every node, docs/BENCHMARKS.md, "Render throughput: kernel changes measured"). Non-entered children are at
+                 * every node, docs/BENCHMARKS.md, "Kernel changes measured"). Non-entered children are at
                  * MAXFLOAT, after every entered one. */
                 float4 r1 = t4.yzwx, r2 = t4.zwxy, r3 = t4.wxyz;
                 int4 before1 = (r1 < t4) | ((r1 == t4) & (int4)(-1, -1, -1, 0));

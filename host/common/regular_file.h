@@ -1,5 +1,5 @@
 // Reading only regular files: a FIFO blocks forever, a directory reads as garbage or throws
-// std::bad_alloc, a device never ends (ROBUSTNESS.md "Files that hang").
+// std::bad_alloc, a device never ends (ROBUSTNESS.md "Inputs that hang or crash the loader").
 #pragma once
 
 #include <sys/types.h>

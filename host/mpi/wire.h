@@ -1,4 +1,4 @@
-// The bytes of the messages between the ranks of one render (docs/MPI.md "Messages"). Native
+// The bytes of the messages between the ranks of one render (docs/MPI.md "How it works"). Native
 // byte order and sizes: every rank runs the same build of mcrt on the same kind of machine.
 // Pure serialization, no MPI, so that it is tested in every build.
 #pragma once

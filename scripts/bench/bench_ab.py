@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Render throughput of kernel or binary variants against each other, in one run: the speed
-comparisons of docs/BENCHMARKS.md ("Render throughput: kernel changes measured").
+comparisons of docs/BENCHMARKS.md ("Kernel changes measured").
 
 Each variant is LABEL=BINARY or LABEL=BINARY@KERNEL_DIR (the kernels read from KERNEL_DIR
 through MCRT_KERNEL_DIR instead of those embedded in BINARY). For every scene, each variant

@@ -1,4 +1,4 @@
-/* Probe for docs/BENCHMARKS.md ("Traverse as a work-group"): does PoCL's work-item
+/* Probe for docs/BENCHMARKS.md ("Where a sample's time goes", its work-group bullet): does PoCL's work-item
  * loop vectoriser make a slab test cheaper when a work-group tests one node for all its rays?
  * Both kernels test every ray against the same NODES 4-wide nodes (random boxes), with the
  * arithmetic of bvh4_entry (kernels/bvh_traverse.cl).
