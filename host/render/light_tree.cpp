@@ -1,9 +1,8 @@
 #include "render/light_tree.h"
 
-#include <cstring>
-
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <glm/glm.hpp>
 #include <limits>
 

@@ -108,7 +108,6 @@ struct RenderVariants {
 
     bool uses(unsigned bits) const { return (estimator.uses & bits) == bits; }
     bool ambient() const { return estimator.kind == EstimatorKind::Ambient; }
-    bool light_tree() const { return light_select->id == LightSelection::Tree; }
     // A pixel's samples are correlated (the sampler or the estimator): the variance layer is
     // estimated from replicates by default.
     bool correlated() const { return sampler->correlated || uses(kUsesCorrelatedSamples); }
