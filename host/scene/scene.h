@@ -9,6 +9,38 @@
 
 namespace mcrt {
 
+// How a texture's coordinates outside [0, 1] are read, per axis (glTF 2.0 "Samplers"; default
+// REPEAT).
+enum class TextureWrap : uint8_t { Repeat, ClampToEdge, MirroredRepeat };
+
+// A decoded glTF image: 8-bit RGBA texels as the file stores them (sRGB-encoded or linear: the
+// slot that reads it says which), row 0 the image's top row, where texture coordinate v = 0 lies
+// (glTF 2.0 "Images"). Grey, grey+alpha and RGB images are widened (alpha 255 when absent).
+struct TextureImage {
+    std::string name;           // its uri or "image N"
+    uint32_t width = 0, height = 0;
+    std::vector<uint8_t> rgba;  // width × height × 4 bytes, row by row
+};
+
+// One texture slot of a material (glTF 2.0 "textureInfo" with its texture's sampler and
+// KHR_texture_transform): which image, how it is read, with which texture coordinates.
+struct TextureRef {
+    int32_t image = -1;     // index into Scene::images; −1: the slot is empty
+    bool srgb = false;      // baseColor and emissive hold sRGB-encoded values; others linear
+    TextureWrap wrap_s = TextureWrap::Repeat, wrap_t = TextureWrap::Repeat;
+    bool linear = true;     // the sampler's magFilter: LINEAR (default) or NEAREST
+    uint32_t texcoord = 0;  // TEXCOORD_n, 0 or 1 (KHR_texture_transform's texCoord applied)
+    // KHR_texture_transform: (u', v') = M (u, v, 1), M = T(offset) R(rotation) S(scale); rows
+    // [0] and [1] of the 2×3 matrix. Identity when absent.
+    glm::vec3 row_u{1.0f, 0.0f, 0.0f}, row_v{0.0f, 1.0f, 0.0f};
+
+    bool used() const { return image >= 0; }
+};
+
+// glTF 2.0 alphaMode: OPAQUE ignores alpha; MASK cuts where alpha < alphaCutoff; BLEND is
+// rendered as stochastic transparency (a ray passes with probability 1 − alpha).
+enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
+
 // glTF 2.0 metallic-roughness surface that may also emit (DESIGN.md "Radiometric contract").
 // Default-constructed it is the course's Lambertian reflector: the glTF importer sets the
 // specification's defaults (metallic 1, specular 1) itself.
@@ -21,6 +53,23 @@ struct Material {
     float roughness = 1.0f;    // roughnessFactor, [0, 1]; GGX α = roughness²
     float specular = 0.0f;     // KHR_materials_specular.specularFactor, [0, 1]; glTF default 1
     glm::vec3 specular_color{1.0f};  // KHR_materials_specular.specularColorFactor, ≥ 0
+    float alpha = 1.0f;        // baseColorFactor.a, [0, 1]
+    AlphaMode alpha_mode = AlphaMode::Opaque;
+    float alpha_cutoff = 0.5f; // MASK only
+    // Texture slots; each multiplies its factor (glTF 2.0 "Metallic-Roughness Material").
+    TextureRef base_color_texture;          // sRGB; RGB × albedo, A × alpha
+    TextureRef metallic_roughness_texture;  // linear; B × metallic, G × roughness
+    TextureRef normal_texture;              // linear; tangent-space normal, scaled in x and y
+    float normal_scale = 1.0f;              // normalTexture.scale
+    TextureRef emissive_texture;            // sRGB; RGB × emission
+
+    // The surface needs the textured kernels (-D MCRT_TEXTURES): a texture, or alpha that a ray
+    // query must test (MASK, BLEND).
+    bool textured() const {
+        return base_color_texture.used() || metallic_roughness_texture.used() ||
+               normal_texture.used() || emissive_texture.used() ||
+               alpha_mode != AlphaMode::Opaque;
+    }
 
     // Exactly the Lambertian albedo/π: no metal, and no specular layer on the dielectric.
     bool lambertian() const { return metallic == 0.0f && specular == 0.0f; }
@@ -38,12 +87,24 @@ struct Camera {
 
 // A triangle soup in world space. Triangle t has vertices positions[3t .. 3t+2],
 // counter-clockwise seen from its front face, and material materials[triangle_material[t]].
+// A scene with a textured material (Material::textured) also has the corners' attributes that
+// textures read, parallel to positions; an untextured scene leaves them empty.
 struct Scene {
     std::string path;
     std::vector<glm::vec3> positions;
     std::vector<uint32_t> triangle_material;
     std::vector<Material> materials;
     std::vector<Camera> cameras;  // in default-scene traversal order
+    std::vector<TextureImage> images;  // those the materials' texture slots name
+    std::vector<glm::vec4> texcoords;  // per corner: .xy TEXCOORD_0, .zw TEXCOORD_1 (0 absent)
+    // Per corner, world space, for materials with a normal texture (zero for the others): the
+    // unit vertex normal (the face's where the primitive has none) and the unit tangent with
+    // its handedness in w (±1; bitangent = w · cross(normal, tangent)), MikkTSpace where the
+    // primitive has no TANGENT.
+    std::vector<glm::vec3> normals;
+    std::vector<glm::vec4> tangents;
+
+    bool textured() const { return !texcoords.empty(); }
 
     size_t triangle_count() const { return triangle_material.size(); }
     glm::vec3 bounds_min() const;
