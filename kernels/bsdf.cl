@@ -27,6 +27,25 @@ typedef struct {
     float cos_theta; /* cosθ of wi about the normal, as the sampler computed it */
 } BsdfSample;
 
+/* True where wi leaves on the viewer's side of the geometric surface. Only a bent shading normal
+ * (textured builds) can put a direction above the shading normal and below the surface: such a
+ * direction carries no light (it would come through the surface), and a sample there is none. */
+inline bool above_surface(const SurfacePoint* sp, float3 wi) {
+#if defined(MCRT_TEXTURES)
+    return dot(sp->ng, wi) > 0.0f;
+#else
+    return true;
+#endif
+}
+
+inline BsdfSample below_surface_checked(const SurfacePoint* sp, BsdfSample s) {
+    if (!above_surface(sp, s.wi)) {
+        s.f = (float3)(0.0f);
+        s.pdf_w = 0.0f;
+    }
+    return s;
+}
+
 #if defined(MCRT_MATERIALS_GLTF)
 
 /* The material's parameters, unpacked (shared_types.h, Material). */
@@ -90,7 +109,7 @@ inline float gltf_pdf_w(const GltfMaterial* m, float3 wo, float3 wi) {
 inline float3 bsdf_eval(const SurfacePoint* sp, float3 wi) {
     Frame frame = frame_from_normal(sp->n);
     float3 wo_l = frame_to_local(&frame, sp->wo), wi_l = frame_to_local(&frame, wi);
-    if (!(wo_l.z > 0.0f) || !(wi_l.z > 0.0f)) return (float3)(0.0f);
+    if (!(wo_l.z > 0.0f) || !(wi_l.z > 0.0f) || !above_surface(sp, wi)) return (float3)(0.0f);
     GltfMaterial m = gltf_material(sp);
     return gltf_brdf(&m, wo_l, wi_l);
 }
@@ -126,7 +145,7 @@ inline BsdfSample bsdf_sample(const SurfacePoint* sp, float2 u) {
     s.f = gltf_brdf(&m, wo, wi);
     s.pdf_w = gltf_mixture_pdf_w(&m, p, wo, wi);
     s.cos_theta = wi.z;
-    return s;
+    return below_surface_checked(sp, s);
 }
 
 /* Density with respect to solid angle of bsdf_sample returning wi (the twin MIS needs). */
@@ -140,7 +159,8 @@ inline float bsdf_pdf_w(const SurfacePoint* sp, float3 wi) {
 
 /* f_r(wo, wi) at sp: albedo/π for directions on the side of the normal, else 0. */
 inline float3 bsdf_eval(const SurfacePoint* sp, float3 wi) {
-    return dot(sp->n, wi) > 0.0f ? sp->material.base_color.xyz * MCRT_INV_PI : (float3)(0.0f);
+    return dot(sp->n, wi) > 0.0f && above_surface(sp, wi) ? sp->material.base_color.xyz * MCRT_INV_PI
+                                                           : (float3)(0.0f);
 }
 
 /* A direction by the BSDF's own density (cosine-weighted for the Lambertian lobe), from u. */
@@ -152,7 +172,7 @@ inline BsdfSample bsdf_sample(const SurfacePoint* sp, float2 u) {
     s.f = sp->material.base_color.xyz * MCRT_INV_PI;
     s.pdf_w = sample_hemisphere_cosine_pdf_w(w);
     s.cos_theta = w.z;
-    return s;
+    return below_surface_checked(sp, s);
 }
 
 /* Density with respect to solid angle of bsdf_sample returning wi (the twin MIS needs). */

@@ -10,6 +10,7 @@ inline SurfacePoint test_surface(Material material, float3 wo) {
     SurfacePoint sp;
     sp.p = sp.p_error = (float3)(0.0f);
     sp.n = (float3)(0.0f, 0.0f, 1.0f);
+    sp.ng = sp.n;
     sp.wo = wo;
     sp.front = true;
     sp.light = 0u;

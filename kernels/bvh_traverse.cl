@@ -8,6 +8,43 @@
 
 #include "intersect.cl"
 
+#if defined(MCRT_TEXTURES)
+#include "textures.cl"
+/* What a ray query needs to test alpha at its candidate hits (MATERIAL_ALPHA_TESTED surfaces):
+ * a masked or blended triangle is a hit only where alpha_keeps says so, in every query alike
+ * (closest hit and any hit), so that a hole neither shades, nor shadows, nor emits. `key` is the
+ * query's own (scene.cl, ray_alpha_test). */
+typedef struct {
+    TextureView textures;
+    global const TriangleInfo* triangle_info;
+    global const Material* materials;
+    uint key;
+} AlphaTest;
+
+inline bool alpha_keeps_lane(const AlphaTest* at, uint lane, float b1, float b2) {
+    TriangleInfo info = at->triangle_info[lane];
+    if (!(at->materials[info.material].flags & MATERIAL_ALPHA_TESTED)) return true;
+    return alpha_keeps(&at->textures, material_textures(&at->textures, info.material),
+                       surface_uv(&at->textures, lane, b1, b2), at->key, lane);
+}
+
+/* The lanes of a packet's hits that alpha keeps; all of them for a query without a test. */
+inline int4 alpha_kept_lanes(const AlphaTest* at, uint packet, int4 lanes, float4 b1, float4 b2) {
+    if (!at || !any(lanes)) return lanes;
+    uint base = MCRT_PACKET_WIDTH * packet;
+    if (lanes.x && !alpha_keeps_lane(at, base, b1.x, b2.x)) lanes.x = 0;
+    if (lanes.y && !alpha_keeps_lane(at, base + 1u, b1.y, b2.y)) lanes.y = 0;
+    if (lanes.z && !alpha_keeps_lane(at, base + 2u, b1.z, b2.z)) lanes.z = 0;
+    if (lanes.w && !alpha_keeps_lane(at, base + 3u, b1.w, b2.w)) lanes.w = 0;
+    return lanes;
+}
+#else
+/* Untextured builds test no alpha: every query passes a null AlphaTest. */
+typedef struct {
+    uint unused;
+} AlphaTest;
+#endif
+
 /* A visited inner node pushes at most 3 of its children (the nearest is visited next), and the
  * stack holds entries of at most MCRT_BVH4_MAX_DEPTH (59) levels: 3 · 59 = 177 entries never
  * overflow. The any-hit traversal pushes up to 4 inner children and pops one at once, but only
@@ -87,12 +124,12 @@ inline int4 skipped_lanes(const SkipLane* s, uint packet) {
 }
 
 /* Closest hit with t in (t_min, t_max), never on the triangle at packet lane `skip`
- * (MCRT_NO_HIT: none). Children are visited nearest first; the others wait on the
+ * (MCRT_NO_HIT: none), nor where `alpha` cuts a surface (textured builds; null: no test). Children are visited nearest first; the others wait on the
  * stack with their entry distances and are skipped once a nearer hit is found. An empty scene's
  * root has only empty slots, so no ray enters it. */
 inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
     global const Bvh4Node* nodes, global const TrianglePacket* packets, const Ray* r, float t_min,
-    float t_max, uint skip) {
+    float t_max, uint skip, const AlphaTest* alpha) {
     Hit hit;
     hit.t = t_max;
     hit.b1 = hit.b2 = 0.0f;
@@ -151,6 +188,9 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
                 uint packet = ref + k / MCRT_PACKET_WIDTH;
                 int4 lanes = intersect_packet(&q, pk, t_min, hit.t, skipped_lanes(&s, packet),
                                               false, &t4, &b1, &b2);
+#if defined(MCRT_TEXTURES)
+                lanes = alpha_kept_lanes(alpha, packet, lanes, b1, b2);
+#endif
                 /* The nearest hit lane, the first of equals (leaf order, as one triangle at a time
                  * would take them), by compares instead of a loop over private arrays; taken by
                  * selects, not a branch on whether any lane hit (which mispredicted). A lane hits
@@ -187,10 +227,10 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
  * traversing again beyond its δt. A camera ray starts on no surface and needs no bound (it cost
  * the bench's primary rays 12% on veach-mis). */
 inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePacket* packets,
-                           const Ray* r, float t_max, uint skip) {
+                           const Ray* r, float t_max, uint skip, const AlphaTest* alpha) {
     float t_min = 0.0f;
     for (;;) {
-        Hit hit = bvh_closest_hit_beyond(nodes, packets, r, t_min, t_max, skip);
+        Hit hit = bvh_closest_hit_beyond(nodes, packets, r, t_min, t_max, skip, alpha);
         if (hit.lane == MCRT_NO_HIT || skip == MCRT_NO_HIT) return hit;
         PacketRay q = make_packet_ray(r);
         float bound = lane_t_rounding_bound(&q, packets + hit.lane / MCRT_PACKET_WIDTH,
@@ -209,7 +249,7 @@ inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePa
  * nearest first, but 8.3 against 5.5 in the modern hall (docs/BENCHMARKS.md, "Ray traversal"). No order
  * wins everywhere; this one gave the best worst-case ratio to Embree over the bench scenes. */
 inline bool bvh_any_hit(global const Bvh4Node* nodes, global const TrianglePacket* packets,
-                        const Ray* r, float t_max, uint skip) {
+                        const Ray* r, float t_max, uint skip, const AlphaTest* alpha) {
     BoxRay b = make_box_ray(r);
     PacketRay q = make_packet_ray(r);
     SkipLane sk = make_skip_lane(skip);
@@ -231,8 +271,11 @@ inline bool bvh_any_hit(global const Bvh4Node* nodes, global const TrianglePacke
             for (uint k = 0; k < count; k += MCRT_PACKET_WIDTH, ++pk) {
                 float4 t4, b1, b2;
                 int4 skipped = skipped_lanes(&sk, child + k / MCRT_PACKET_WIDTH);
-                if (any(intersect_packet(&q, pk, 0.0f, t_max, skipped, true, &t4, &b1, &b2)))
-                    return true;
+                int4 lanes = intersect_packet(&q, pk, 0.0f, t_max, skipped, true, &t4, &b1, &b2);
+#if defined(MCRT_TEXTURES)
+                lanes = alpha_kept_lanes(alpha, child + k / MCRT_PACKET_WIDTH, lanes, b1, b2);
+#endif
+                if (any(lanes)) return true;
             }
         }
         if (sp == 0) return false;

@@ -47,6 +47,29 @@ inline LightSample no_light_sample(void) {
 /* LightSample.light of a direction toward the sky light. */
 #define LIGHT_SKY 0xffffffffu
 
+/* Radiance that light `light` emits at barycentrics b of its vertices 1 and 2: its Le, or where
+ * its emission varies over it (textured builds, MATERIAL_TEXTURED) Le × the emissive texture
+ * there, none in a MASK hole, × alpha on a BLEND surface (which a ray hits with probability
+ * alpha: the same expectation). */
+inline float3 light_emission(const SceneView* scene, const Light* light, float2 b) {
+#if defined(MCRT_TEXTURES)
+    if (light->flags & MATERIAL_TEXTURED) {
+        const TextureView* tv = &scene->textures;
+        global const MaterialTextures* mt = material_textures(tv, light->material);
+        float4 uv = surface_uv(tv, light->surface, b.x, b.y);
+        float3 Le = light->Le.xyz;
+        if (texture_slot_used(&mt->emissive)) Le *= texture_lookup(tv, &mt->emissive, uv).xyz;
+        if (mt->alpha_mode == MATERIAL_ALPHA_MASK) {
+            if (!(material_alpha(tv, mt, uv) >= mt->alpha_cutoff)) Le = (float3)(0.0f);
+        } else if (mt->alpha_mode == MATERIAL_ALPHA_BLEND) {
+            Le *= material_alpha(tv, mt, uv);
+        }
+        return Le;
+    }
+#endif
+    return light->Le.xyz;
+}
+
 /* ---- The sky beside the area lights ---------------------------------------------------------- */
 
 /* Chooses between the sky light, with probability env.sky_pmf, and the area lights, as pbrt-v4
@@ -170,7 +193,7 @@ inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint*
     ls.y = lp.p;
     ls.y_error = lp.p_error;
     ls.n_toward = dot(n_light, wi) < 0.0f ? n_light : -n_light;
-    ls.Le = light.Le.xyz;
+    ls.Le = light_emission(scene, &light, lp.b);
     ls.pmf = choice.pmf;
     ls.pdf = lp.pdf_a;
     ls.d2 = d2;
@@ -202,6 +225,7 @@ inline LightSample sample_light_solid_angle(const SceneView* scene, const Surfac
            c = normalize(light.p2.xyz - x);
     float omega = spherical_triangle_solid_angle(a, b, c);
     float3 wi, y, y_error;
+    float2 b_y; /* y's barycentrics */
     float pdf_w;
     if (omega > MIN_SPHERICAL_SOLID_ANGLE && omega < MAX_SPHERICAL_SOLID_ANGLE) {
         wi = sample_spherical_triangle_omega(a, b, c, omega, u);
@@ -218,6 +242,11 @@ inline LightSample sample_light_solid_angle(const SceneView* scene, const Surfac
          * add γ(2)·(|x| + |t·wi|), and the normal's own rounding tilts the plane about p0 by
          * γ(4)·|y − p0|, bounded by |p0 − x| + |t·wi|. */
         y_error = MCRT_GAMMA(8) * (fabs(x) + fabs(t_wi) + fabs(to_p0));
+#if defined(MCRT_TEXTURES)
+        b_y = light_barycentrics(&light, y);
+#else
+        b_y = (float2)(0.0f);
+#endif
     } else {
         LightPoint lp = sample_light_point(&light, u);
         float3 to_light = lp.p - x;
@@ -229,6 +258,7 @@ inline LightSample sample_light_solid_angle(const SceneView* scene, const Surfac
         pdf_w = pdf_area_to_solid_angle(lp.pdf_a, d2, cos_y);
         y = lp.p;
         y_error = lp.p_error;
+        b_y = lp.b;
     }
     float cos_y = light_emitting_cosine(&light, n_light, wi);
     if (cos_y <= 0.0f) return ls;
@@ -237,7 +267,7 @@ inline LightSample sample_light_solid_angle(const SceneView* scene, const Surfac
     ls.y = y;
     ls.y_error = y_error;
     ls.n_toward = dot(n_light, wi) < 0.0f ? n_light : -n_light;
-    ls.Le = light.Le.xyz;
+    ls.Le = light_emission(scene, &light, b_y);
     ls.pmf = choice.pmf;
     ls.pdf = pdf_w;
     ls.d2 = dot(d, d);
@@ -271,7 +301,8 @@ inline bool light_sample_visible(const SceneView* scene, const SurfacePoint* sp,
                                  const LightSample* ls) {
     if (ls->light == LIGHT_SKY) { /* nothing along the ray to infinity */
         Ray r = make_ray(spawn_origin(sp), ls->wi);
-        return !bvh_any_hit(scene->nodes, scene->packets, &r, MAXFLOAT, sp->lane);
+        AlphaTest at = ray_alpha_test(scene, &r);
+        return !bvh_any_hit(scene->nodes, scene->packets, &r, MAXFLOAT, sp->lane, &at);
     }
     return visible(scene, sp, ls->y, ls->y_error, ls->n_toward);
 }
@@ -286,7 +317,7 @@ inline float pdf_light_area(const SceneView* scene, const SurfacePoint* sp,
     uint index = seen->light - 1u;
     Light light = scene->lights.lights[index];
     float3 d = seen->p - sp->p;
-    float cos_y = fabs(dot(seen->n, wi));
+    float cos_y = fabs(dot(seen->ng, wi));
     float pmf = chosen_light_pmf(scene, sp, index);
     return light_area_pdf_w(pmf, sample_triangle_uniform_pdf_a(light_area(&light)), dot(d, d),
                             cos_y);

@@ -91,6 +91,7 @@ inline float3 light_normal(const Light* light) {
 typedef struct {
     float3 p;       /* point on the light */
     float3 p_error; /* per-component bound on p's distance from the light's plane */
+    float2 b;       /* its barycentrics of vertices 1 and 2 */
     float pdf_a;
 } LightPoint;
 
@@ -102,8 +103,24 @@ inline LightPoint sample_light_point(const Light* light, float2 u) {
     float3 b1_e1 = b.x * (light->p1.xyz - p0), b2_e2 = b.y * (light->p2.xyz - p0);
     lp.p = p0 + b1_e1 + b2_e2;
     lp.p_error = interpolation_error(p0, b1_e1, b2_e2);
+    lp.b = b;
     lp.pdf_a = sample_triangle_uniform_pdf_a(light_area(light));
     return lp;
+}
+
+/* Barycentrics (of vertices 1 and 2) of a point y in the light's plane, clamped to the
+ * triangle: where a direction sampled in its spherical triangle meets it. */
+inline float2 light_barycentrics(const Light* light, float3 y) {
+    float3 e1 = light->p1.xyz - light->p0.xyz, e2 = light->p2.xyz - light->p0.xyz;
+    float3 v = y - light->p0.xyz;
+    float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2);
+    float dv1 = dot(v, e1), dv2 = dot(v, e2);
+    float denom = d11 * d22 - d12 * d12;
+    if (!(denom > 0.0f)) return (float2)(0.0f);
+    float2 b = (float2)(d22 * dv1 - d12 * dv2, d11 * dv2 - d12 * dv1) / denom;
+    b = clamp(b, 0.0f, 1.0f);
+    float s = b.x + b.y;
+    return s > 1.0f ? b / s : b;
 }
 
 /* Cosine at the light between its normal and the direction wi from the receiver toward it:

@@ -24,6 +24,15 @@ typedef struct {
     bool roulette;
 } PathRecord;
 
+/* The stochastic-transparency key of the stream's vertex (textured builds): its DIM_ALPHA
+ * number with the pixel and the sample, so that every sample decides blended surfaces anew. */
+inline void set_alpha_key(const SceneView* scene, const SampleStream* stream) {
+#if defined(MCRT_TEXTURES)
+    *scene->alpha_key = alpha_hash(as_uint(sample_1d(stream, DIM_ALPHA)) ^
+                                          alpha_hash(stream->pixel ^ alpha_hash(stream->index)));
+#endif
+}
+
 /* Radiance arriving along camera ray r after at most max_depth reflections: L_e at the first hit,
  * plus at each vertex k < max_depth the throughput times the estimator's estimate of the light
  * reflected there directly (its own strategies; emitters that the continuation later finds are
@@ -36,7 +45,10 @@ inline float3 path_radiance(const SceneView* scene, const Ray* r, SampleStream* 
                             uint max_depth, uint rr_depth, PathRecord* record) {
     PathContinuation* given = scene->continuation; /* 0 for direct lighting */
     record->rays += 1u;
-    Hit hit = bvh_closest_hit(scene->nodes, scene->packets, r, MAXFLOAT, MCRT_NO_HIT);
+    stream->vertex = 0u;
+    set_alpha_key(scene, stream);
+    AlphaTest at = ray_alpha_test(scene, r);
+    Hit hit = bvh_closest_hit(scene->nodes, scene->packets, r, MAXFLOAT, MCRT_NO_HIT, &at);
 #if defined(MCRT_AMBIENT_ESTIMATOR)
     if (hit.lane == MCRT_NO_HIT) return scene->env.sky;
 #else
@@ -49,6 +61,7 @@ inline float3 path_radiance(const SceneView* scene, const Ray* r, SampleStream* 
     for (uint k = 0u; k < max_depth;) {
         /* Direct light at vertex k, by the estimator's strategies. */
         stream->vertex = k;
+        set_alpha_key(scene, stream);
         if (given) given->given = false;
         L += beta * MCRT_ESTIMATE(scene, &sp, stream, &record->rays);
         if (++k == max_depth) break;

@@ -13,6 +13,7 @@
 kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                    global const TriangleInfo* triangle_info, global const Material* materials,
                    global const Light* lights, global const uint* light_selection,
+                   global const TriangleSurface* surfaces, global const uint* textures,
                    global const CameraGpu* camera, global uint4* samples, RenderParams p) {
     size_t g = get_global_id(0);
     uint pixel = p.pixel_begin + (uint)(g / p.batch_samples);
@@ -39,6 +40,12 @@ kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* pa
     PathContinuation continuation;
     continuation.given = false;
     scene.continuation = p.max_depth > 1u ? &continuation : 0; /* direct lighting goes no further */
+#if defined(MCRT_TEXTURES)
+    uint alpha_key = 0u;
+    scene.textures.data = textures;
+    scene.textures.surfaces = surfaces;
+    scene.alpha_key = &alpha_key;
+#endif
 
     float3 dir = camera_direction(camera, pixel % p.width, pixel / p.width,
                                   sample_2d(&stream, DIM_PIXEL_JITTER), p.width, p.height);

@@ -57,6 +57,9 @@ inline uint replicate_seed(const SampleStream* s) { return s->seed ^ (s->replica
                                  sample for both (discrete.cl) */
 #define DIM_DIRECTION 5u      /* 2D: hemisphere or BSDF direction (hemisphere, MIS, ambient) */
 #define DIM_PIXEL_ROTATION 7u /* 2D, per pixel: rotation of the Fibonacci spiral */
+/* 1D, textured builds: the key of a vertex's stochastic transparency (path.cl, textures.cl);
+ * beyond the vertices' blocks, so that untextured renders read exactly the numbers they did. */
+#define DIM_ALPHA 0x80000u
 /* Dimensions DIM_USER, DIM_USER + 1, ... belong to users' estimators: no built-in code uses
  * them, now or later (docs/ESTIMATORS.md); DIM_USER_PER_VERTEX of them at each vertex. */
 #define DIM_USER 0x100000u

@@ -25,19 +25,92 @@ typedef struct {
     Environment env;
     PathContinuation* continuation; /* where trace_bsdf_sample hands the path its BSDF sample
                                        (api.cl); 0 where no path goes on (direct lighting) */
+#if defined(MCRT_TEXTURES)
+    TextureView textures;
+    uint* alpha_key; /* the current vertex's stochastic-transparency key (path.cl) */
+#endif
 } SceneView;
 
 /* A surface point seen along a ray. */
 typedef struct {
     float3 p;       /* from barycentrics, not from o + t·d (PBRT 4th ed. sec. 6.8.5) */
     float3 p_error; /* per-component bound on p's distance from its triangle (geometry.cl) */
-    float3 n;       /* unit geometric normal, flipped toward the incoming ray */
+    float3 n;       /* unit shading normal, on the incoming ray's side: the geometric normal,
+                       or where a normal texture bends it, the bent one (textured builds) */
+    float3 ng;      /* unit geometric normal, flipped toward the incoming ray: rays leave the
+                       surface on its side, and no light arrives from behind it */
     float3 wo;  /* unit, toward where the ray came from */
     bool front; /* the ray arrived on the counter-clockwise (front) side */
     uint light; /* index of its Light plus one; 0 when it is not a light */
     uint lane;  /* its triangle's packet lane, which rays leaving it skip; MCRT_NO_HIT: none */
     Material material;
 } SurfacePoint;
+
+#if defined(MCRT_TEXTURES)
+/* The bent normal of a normal texture (glTF 2.0 "normalTexture": tangent space, +Y up, x and y
+ * scaled by `scale`) about the interpolated vertex normal and MikkTSpace tangent, on the side of
+ * the geometric normal ng that the ray arrived on, and turned toward the viewer where the texture
+ * tilts it away (else the BSDF would be black seen from there); ng where the frame degenerates. */
+inline float3 bent_normal(const TextureView* tv, global const MaterialTextures* mt, uint lane,
+                          float b1, float b2, float4 uv, const SurfacePoint* sp) {
+    global const TriangleSurface* s = tv->surfaces + lane;
+    float b0 = 1.0f - b1 - b2;
+    float3 n = (b0 * s->normal[0] + b1 * s->normal[1] + b2 * s->normal[2]).xyz;
+    float4 t4 = b0 * s->tangent[0] + b1 * s->tangent[1] + b2 * s->tangent[2];
+    float3 t = t4.xyz - n * dot(n, t4.xyz);
+    if (!(dot(n, n) > 0.0f) || !(dot(t, t) > 0.0f)) return sp->ng;
+    n = normalize(n);
+    t = normalize(t);
+    float3 b = cross(n, t) * (t4.w < 0.0f ? -1.0f : 1.0f);
+    float3 c = texture_lookup(tv, &mt->normal, uv).xyz * 2.0f - 1.0f;
+    float3 ns = normalize((c.x * mt->normal_scale) * t + (c.y * mt->normal_scale) * b + c.z * n);
+    if (!sp->front) ns = -ns;
+    if (!(dot(ns, sp->ng) > 0.0f)) return sp->ng;
+    /* Turned toward wo until wo is at least 0.01 above it. */
+    float c_o = dot(ns, sp->wo);
+    if (c_o < 0.01f) ns = normalize(ns + (0.01f - c_o) * sp->wo);
+    return ns;
+}
+
+/* The material's textures evaluated at the hit (MaterialTextures): base colour and alpha,
+ * metallic and roughness, emission, the shading normal. */
+inline void apply_textures(const SceneView* scene, uint material, uint lane, float b1, float b2,
+                           SurfacePoint* sp) {
+    const TextureView* tv = &scene->textures;
+    global const MaterialTextures* mt = material_textures(tv, material);
+    float4 uv = surface_uv(tv, lane, b1, b2);
+    if (texture_slot_used(&mt->base_color))
+        sp->material.base_color *= texture_lookup(tv, &mt->base_color, uv);
+    if (texture_slot_used(&mt->metallic_roughness)) {
+        float4 c = texture_lookup(tv, &mt->metallic_roughness, uv);
+        sp->material.metallic *= c.z;
+        float roughness = mt->roughness * c.y;
+        sp->material.alpha = fmax(roughness * roughness, MCRT_ALPHA_MIN);
+    }
+    if (texture_slot_used(&mt->emissive))
+        sp->material.emission.xyz *= texture_lookup(tv, &mt->emissive, uv).xyz;
+    if (texture_slot_used(&mt->normal)) sp->n = bent_normal(tv, mt, lane, b1, b2, uv, sp);
+}
+
+/* The alpha test of a ray query: the vertex's key mixed with the ray's direction, so that each
+ * query (the camera ray, each shadow ray, each continuation) decides a blended surface on its
+ * own number. */
+inline AlphaTest ray_alpha_test(const SceneView* scene, const Ray* r) {
+    AlphaTest at;
+    at.textures = scene->textures;
+    at.triangle_info = scene->triangle_info;
+    at.materials = scene->materials;
+    uint3 d = as_uint3(r->dir);
+    at.key = alpha_hash(*scene->alpha_key ^ alpha_hash(d.x ^ alpha_hash(d.y ^ alpha_hash(d.z))));
+    return at;
+}
+#else
+inline AlphaTest ray_alpha_test(const SceneView* scene, const Ray* r) {
+    AlphaTest at;
+    at.unused = 0u;
+    return at;
+}
+#endif
 
 inline SurfacePoint surface_point(const SceneView* scene, const Ray* r, const Hit* hit) {
     /* The vertices from the hit's packet lane: coordinate a of vertex k at v[3k + a].lane. */
@@ -80,9 +153,14 @@ inline SurfacePoint surface_point(const SceneView* scene, const Ray* r, const Hi
     float3 ng = normalize(cross(e1, e2));
     sp.front = dot(ng, r->dir) < 0.0f;
     sp.n = sp.front ? ng : -ng;
+    sp.ng = sp.n;
     sp.wo = -normalize(r->dir);
     sp.light = info.light;
     sp.material = scene->materials[info.material];
+#if defined(MCRT_TEXTURES)
+    if (sp.material.flags & MATERIAL_TEXTURED)
+        apply_textures(scene, info.material, hit->lane, hit->b1, hit->b2, &sp);
+#endif
     return sp;
 }
 
@@ -97,9 +175,9 @@ inline float3 environment_radiance(const SceneView* scene) {
     return scene->env.sky_pmf > 0.0f ? scene->env.sky : (float3)(0.0f);
 }
 
-/* The origin of rays leaving sp on the side of its normal (geometry.cl). */
+/* The origin of rays leaving sp on the side of its geometric normal (geometry.cl). */
 inline float3 spawn_origin(const SurfacePoint* sp) {
-    return offset_ray_origin(sp->p, sp->p_error, sp->n);
+    return offset_ray_origin(sp->p, sp->p_error, sp->ng);
 }
 
 /* True if nothing blocks the segment from sp to the point y, whose per-component error bound
@@ -112,7 +190,8 @@ inline bool visible(const SceneView* scene, const SurfacePoint* sp, float3 y, fl
     float3 o = spawn_origin(sp);
     float3 target = offset_ray_origin(y, y_error, n_y);
     Ray shadow = make_ray(o, target - o);
-    return !bvh_any_hit(scene->nodes, scene->packets, &shadow, 1.0f, sp->lane);
+    AlphaTest at = ray_alpha_test(scene, &shadow);
+    return !bvh_any_hit(scene->nodes, scene->packets, &shadow, 1.0f, sp->lane, &at);
 }
 
 /* The first surface along direction wi (unit, world) from sp, leaving its surface as visible
@@ -122,19 +201,25 @@ inline bool trace_from(const SceneView* scene, const SurfacePoint* sp, float3 wi
                        SurfacePoint* seen) {
     *rays += 1u;
     Ray r = make_ray(spawn_origin(sp), wi);
-    Hit hit = bvh_closest_hit(scene->nodes, scene->packets, &r, MAXFLOAT, sp->lane);
+    AlphaTest at = ray_alpha_test(scene, &r);
+    Hit hit = bvh_closest_hit(scene->nodes, scene->packets, &r, MAXFLOAT, sp->lane, &at);
     bool found = hit.lane != MCRT_NO_HIT;
     if (found) *seen = surface_point(scene, &r, &hit);
     return found;
 }
 
 /* True if the ray from sp along wi (unit, world) leaves the scene within t_max (MAXFLOAT:
- * unbounded). Counts the ray in *rays. */
+ * unbounded). Counts the ray in *rays. A direction behind the geometric surface (a bent normal's
+ * hemisphere reaches below it) does not leave: the surface itself blocks it. */
 inline bool escapes(const SceneView* scene, const SurfacePoint* sp, float3 wi, float t_max,
                     uint* rays) {
     *rays += 1u;
+#if defined(MCRT_TEXTURES)
+    if (!(dot(wi, sp->ng) > 0.0f)) return false;
+#endif
     Ray r = make_ray(spawn_origin(sp), wi);
-    return !bvh_any_hit(scene->nodes, scene->packets, &r, t_max, sp->lane);
+    AlphaTest at = ray_alpha_test(scene, &r);
+    return !bvh_any_hit(scene->nodes, scene->packets, &r, t_max, sp->lane, &at);
 }
 
 #endif

@@ -125,6 +125,11 @@ typedef struct {
 } Triangle;
 
 #define MATERIAL_DOUBLE_SIDED 1u
+/* Some texture slot is used: shading evaluates the material's textures at the hit (-D
+ * MCRT_TEXTURES builds only, MaterialTextures). On a Light: its emission varies over it. */
+#define MATERIAL_TEXTURED 2u
+/* alphaMode MASK or BLEND: every ray query tests the surface's alpha at a candidate hit. */
+#define MATERIAL_ALPHA_TESTED 4u
 
 /* Material.type: the reflection model of a surface. The kernels' build follows the scene
  * (DESIGN.md "Radiometric contract": model no more than a scene needs): a scene whose every
@@ -157,10 +162,13 @@ typedef struct {
  * beside their power (its CDF, alias table or tree) lives in that selection's own buffer. */
 typedef struct {
     float4 p0, p1, p2; /* vertices, counter-clockwise seen from the front; .w 0 */
-    float4 Le;         /* .xyz emitted radiance; .w 0 */
+    float4 Le;         /* .xyz emitted radiance (the factor; × its texture where MATERIAL_TEXTURED);
+                          .w 0 */
     float area;
-    uint flags;        /* MATERIAL_DOUBLE_SIDED */
-    uint pad0, pad1;
+    uint flags;        /* MATERIAL_DOUBLE_SIDED, MATERIAL_TEXTURED (emission varies over it, or
+                          alpha cuts it: evaluated at the sampled point) */
+    uint material;     /* index into the materials */
+    uint surface;      /* its triangle's packet lane (TriangleSurface, TriangleInfo) */
 } Light;
 
 /* Node of the light tree (host/render/light_tree.h), 64 bytes: the bounds of the lights below it
@@ -207,6 +215,76 @@ typedef struct {
     float pmf;
     uint pad0;
 } AliasEntry;
+
+/* ---- Textures (-D MCRT_TEXTURES builds; docs/MATERIALS.md "Textures") ---------------------- */
+
+/* TextureSlot.image of an empty slot. */
+#define MCRT_NO_TEXTURE 0xffffffffu
+
+/* TextureSlot.mode: the wrap mode of each axis (glTF 2.0 "Samplers"), in 2 bits each at
+ * TEXTURE_WRAP_S_SHIFT and TEXTURE_WRAP_T_SHIFT, the magnification filter, the transfer
+ * function and the texture-coordinate set. */
+#define TEXTURE_WRAP_REPEAT 0u
+#define TEXTURE_WRAP_CLAMP 1u
+#define TEXTURE_WRAP_MIRROR 2u
+#define TEXTURE_WRAP_S_SHIFT 0u
+#define TEXTURE_WRAP_T_SHIFT 2u
+#define TEXTURE_LINEAR 16u    /* bilinear; else nearest */
+#define TEXTURE_SRGB 32u      /* colour channels sRGB-encoded (baseColor, emissive) */
+#define TEXTURE_TEXCOORD_1 64u /* reads TEXCOORD_1; else TEXCOORD_0 */
+
+/* A material's texture in one slot, 32 bytes: KHR_texture_transform's 2×3 matrix
+ * (u' = m.x·u + m.y·v + offset_u, v' = m.z·u + m.w·v + offset_v) and how it is read. */
+typedef struct {
+    float4 m;
+    float offset_u, offset_v;
+    uint image;  /* index of its TextureImageGpu; MCRT_NO_TEXTURE: empty */
+    uint mode;   /* TEXTURE_* */
+} TextureSlot;
+
+/* MaterialTextures.alpha_mode (glTF 2.0 alphaMode). */
+#define MATERIAL_ALPHA_OPAQUE 0u
+#define MATERIAL_ALPHA_MASK 1u
+#define MATERIAL_ALPHA_BLEND 2u
+
+/* The textures and alpha of one material, 160 bytes, parallel to the materials. */
+typedef struct {
+    TextureSlot base_color;         /* sRGB: RGB × base_color, A × its alpha */
+    TextureSlot metallic_roughness; /* linear: B × metallic, G × roughness */
+    TextureSlot normal;             /* linear: tangent-space normal */
+    TextureSlot emissive;           /* sRGB: RGB × emission */
+    float base_alpha;   /* baseColorFactor.a */
+    float alpha_cutoff; /* MASK: cut where alpha < alpha_cutoff */
+    float normal_scale; /* normalTexture.scale */
+    uint alpha_mode;    /* MATERIAL_ALPHA_* */
+    float roughness;    /* roughnessFactor (Material.alpha is its square, clamped) */
+    uint pad0, pad1, pad2;
+} MaterialTextures;
+
+/* One image of the texel data, 16 bytes: its texels, row by row from the top, one RGBA8 texel
+ * per 32-bit word (red in the low byte). */
+typedef struct {
+    uint offset;  /* first texel, in words from the start of the texels */
+    uint width, height;
+    uint pad0;
+} TextureImageGpu;
+
+/* Head of the texture data (RENDER_ARG_TEXTURES), 16 bytes, followed by the materials'
+ * MaterialTextures; each offset in 32-bit words from the start of the data. */
+typedef struct {
+    uint materials; /* count of MaterialTextures after the head */
+    uint images;    /* the TextureImageGpu table */
+    uint decode;    /* 512 floats: 8-bit value → linear for sRGB (256), then for linear (256) */
+    uint texels;
+} TextureHeader;
+
+/* What texture lookups need of a triangle besides its vertices, 144 bytes, one per packet lane as
+ * TriangleInfo (zeros for unused lanes), for the corners in the order of its vertices. */
+typedef struct {
+    float4 uv[3];      /* .xy TEXCOORD_0, .zw TEXCOORD_1 */
+    float4 normal[3];  /* .xyz unit vertex normal (normal-textured materials only); .w 0 */
+    float4 tangent[3]; /* .xyz unit tangent, .w handedness ±1 (bitangent w·n×t) */
+} TriangleSurface;
 
 /* Pinhole camera, 64 bytes. A ray through film point (x, y) in [-1, 1]² (x right, y up) has
  * direction forward + x·right + y·up, where right and up are already scaled by
@@ -269,6 +347,10 @@ enum RenderArgument {
                                    AliasEntry), the tree's nodes (light_tree_nodes
                                    LightTreeNode) followed by the lights' LightTreePath;
                                    uniform reads none */
+    RENDER_ARG_SURFACES,        /* global const TriangleSurface*: per packet lane (textured
+                                   builds; a placeholder otherwise) */
+    RENDER_ARG_TEXTURES,        /* global const uint*: TextureHeader, MaterialTextures, images,
+                                   decode tables, texels (textured builds; else a placeholder) */
     RENDER_ARG_CAMERA,          /* global const CameraGpu* */
     RENDER_ARG_SAMPLES,         /* global uint4*: out, one per work-item (the radiance's bits,
                                    the packed PathRecord) */
@@ -294,6 +376,21 @@ enum RenderArgument {
     FIELD(Material, type, 56) FIELD(Material, flags, 60)                                        \
     TYPE(Light, 80, 16) FIELD(Light, p0, 0) FIELD(Light, p1, 16) FIELD(Light, p2, 32)           \
     FIELD(Light, Le, 48) FIELD(Light, area, 64) FIELD(Light, flags, 68)                         \
+    FIELD(Light, material, 72) FIELD(Light, surface, 76)                                        \
+    TYPE(TextureSlot, 32, 16) FIELD(TextureSlot, m, 0) FIELD(TextureSlot, offset_u, 16)         \
+    FIELD(TextureSlot, offset_v, 20) FIELD(TextureSlot, image, 24) FIELD(TextureSlot, mode, 28) \
+    TYPE(MaterialTextures, 160, 16) FIELD(MaterialTextures, base_color, 0)                      \
+    FIELD(MaterialTextures, metallic_roughness, 32) FIELD(MaterialTextures, normal, 64)         \
+    FIELD(MaterialTextures, emissive, 96) FIELD(MaterialTextures, base_alpha, 128)              \
+    FIELD(MaterialTextures, alpha_cutoff, 132) FIELD(MaterialTextures, normal_scale, 136)       \
+    FIELD(MaterialTextures, alpha_mode, 140) FIELD(MaterialTextures, roughness, 144)            \
+    TYPE(TextureImageGpu, 16, 4) FIELD(TextureImageGpu, offset, 0)                              \
+    FIELD(TextureImageGpu, width, 4) FIELD(TextureImageGpu, height, 8)                          \
+    TYPE(TextureHeader, 16, 4) FIELD(TextureHeader, materials, 0)                               \
+    FIELD(TextureHeader, images, 4) FIELD(TextureHeader, decode, 8)                             \
+    FIELD(TextureHeader, texels, 12)                                                            \
+    TYPE(TriangleSurface, 144, 16) FIELD(TriangleSurface, uv, 0)                                \
+    FIELD(TriangleSurface, normal, 48) FIELD(TriangleSurface, tangent, 96)                      \
     TYPE(LightTreePath, 8, 4) FIELD(LightTreePath, bits, 0) FIELD(LightTreePath, length, 4)     \
     TYPE(AliasEntry, 16, 4) FIELD(AliasEntry, threshold, 0) FIELD(AliasEntry, alias, 4)         \
     FIELD(AliasEntry, pmf, 8)                                                                   \

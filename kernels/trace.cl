@@ -11,7 +11,7 @@ kernel void trace_closest(global const Bvh4Node* nodes, global const TrianglePac
     size_t g = get_global_id(0);
     if (g >= ray_count) return;
     Ray r = make_ray(origins[g].xyz, directions[g].xyz);
-    Hit h = bvh_closest_hit(nodes, packets, &r, origins[g].w, MCRT_NO_HIT);
+    Hit h = bvh_closest_hit(nodes, packets, &r, origins[g].w, MCRT_NO_HIT, 0);
     uint triangle = h.lane == MCRT_NO_HIT
                         ? MCRT_NO_HIT
                         : packets[h.lane / MCRT_PACKET_WIDTH].index[h.lane % MCRT_PACKET_WIDTH];

@@ -50,6 +50,8 @@ void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene,
     CL_CHECK(render.setArg(gpu::RENDER_ARG_MATERIALS, scene.materials));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_LIGHTS, scene.lights));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_LIGHT_SELECTION, scene.light_selection));
+    CL_CHECK(render.setArg(gpu::RENDER_ARG_SURFACES, scene.surfaces));
+    CL_CHECK(render.setArg(gpu::RENDER_ARG_TEXTURES, scene.textures));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_CAMERA, scene.camera));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_SAMPLES, samples));
 }

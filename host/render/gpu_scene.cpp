@@ -1,17 +1,115 @@
 #include "render/gpu_scene.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 
 #include "cl/cl_error.h"
 #include "render/discrete.h"
 #include "render/light_tree.h"
+#include "scene/texture_lookup.h"
 
 namespace mcrt {
 
 
 static gpu::float4 to_float4(const glm::vec3& v, float w = 0.0f) { return {v.x, v.y, v.z, w}; }
+
+namespace {
+
+uint32_t wrap_bits(TextureWrap wrap) {
+    switch (wrap) {
+        case TextureWrap::Repeat: return TEXTURE_WRAP_REPEAT;
+        case TextureWrap::ClampToEdge: return TEXTURE_WRAP_CLAMP;
+        case TextureWrap::MirroredRepeat: return TEXTURE_WRAP_MIRROR;
+    }
+    return TEXTURE_WRAP_REPEAT;
+}
+
+gpu::TextureSlot texture_slot(const TextureRef& ref) {
+    gpu::TextureSlot slot{};
+    slot.image = ref.used() ? uint32_t(ref.image) : MCRT_NO_TEXTURE;
+    slot.m = {ref.row_u.x, ref.row_u.y, ref.row_v.x, ref.row_v.y};
+    slot.offset_u = ref.row_u.z;
+    slot.offset_v = ref.row_v.z;
+    slot.mode = (wrap_bits(ref.wrap_s) << TEXTURE_WRAP_S_SHIFT) |
+                (wrap_bits(ref.wrap_t) << TEXTURE_WRAP_T_SHIFT) |
+                (ref.linear ? TEXTURE_LINEAR : 0u) | (ref.srgb ? TEXTURE_SRGB : 0u) |
+                (ref.texcoord == 1 ? TEXTURE_TEXCOORD_1 : 0u);
+    return slot;
+}
+
+uint32_t alpha_mode_bits(AlphaMode mode) {
+    switch (mode) {
+        case AlphaMode::Opaque: return MATERIAL_ALPHA_OPAQUE;
+        case AlphaMode::Mask: return MATERIAL_ALPHA_MASK;
+        case AlphaMode::Blend: return MATERIAL_ALPHA_BLEND;
+    }
+    return MATERIAL_ALPHA_OPAQUE;
+}
+
+template <typename T>
+void append_words(std::vector<uint32_t>& words, const T* items, size_t count) {
+    static_assert(sizeof(T) % sizeof(uint32_t) == 0, "whole words");
+    const size_t at = words.size();
+    words.resize(at + count * sizeof(T) / sizeof(uint32_t));
+    if (count) std::memcpy(words.data() + at, items, count * sizeof(T));
+}
+
+// RENDER_ARG_TEXTURES (shared_types.h, TextureHeader): the head, the materials' textures, the
+// images' table, the decode tables, the texels (RGBA8 per word, red in the low byte: the bytes in
+// memory order on a little-endian host, as every OpenCL device here is).
+std::vector<uint32_t> texture_words(const Scene& scene) {
+    std::vector<gpu::MaterialTextures> materials;
+    for (const Material& m : scene.materials) {
+        gpu::MaterialTextures t{};
+        t.base_color = texture_slot(m.base_color_texture);
+        t.metallic_roughness = texture_slot(m.metallic_roughness_texture);
+        t.normal = texture_slot(m.normal_texture);
+        t.emissive = texture_slot(m.emissive_texture);
+        t.base_alpha = m.alpha;
+        t.alpha_cutoff = m.alpha_cutoff;
+        t.normal_scale = m.normal_scale;
+        t.alpha_mode = alpha_mode_bits(m.alpha_mode);
+        t.roughness = m.roughness;
+        materials.push_back(t);
+    }
+    if (materials.empty()) materials.push_back(gpu::MaterialTextures{});
+    std::vector<gpu::TextureImageGpu> images;
+    uint64_t texels = 0;
+    for (const TextureImage& image : scene.images) {
+        gpu::TextureImageGpu g{};
+        g.offset = uint32_t(texels);
+        g.width = image.width;
+        g.height = image.height;
+        images.push_back(g);
+        texels += uint64_t(image.width) * image.height;
+        if (texels > 0xffffffffu) throw RuntimeError("textures exceed 2^32 texels");
+    }
+    gpu::TextureHeader head{};
+    std::vector<uint32_t> words;
+    append_words(words, &head, 1);
+    append_words(words, materials.data(), materials.size());
+    head.materials = uint32_t(materials.size());
+    head.images = uint32_t(words.size());
+    append_words(words, images.data(), images.size());
+    head.decode = uint32_t(words.size());
+    std::array<float, 512> decode{};
+    for (int c = 0; c < 256; ++c) {
+        decode[size_t(c)] = srgb_table()[size_t(c)];
+        decode[256 + size_t(c)] = float(c) / 255.0f;
+    }
+    append_words(words, decode.data(), decode.size());
+    head.texels = uint32_t(words.size());
+    for (const TextureImage& image : scene.images) {
+        append_words(words, reinterpret_cast<const uint32_t*>(image.rgba.data()),
+                     image.rgba.size() / 4);
+    }
+    std::memcpy(words.data(), &head, sizeof head);
+    return words;
+}
+
+}  // namespace
 
 gpu::CameraGpu make_gpu_camera(const Camera& camera, int width, int height) {
     const glm::mat4& m = camera.camera_to_world;
@@ -43,18 +141,33 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
         g.alpha = alpha;
         g.type = m.lambertian() ? MATERIAL_LAMBERTIAN : MATERIAL_METALLIC_ROUGHNESS;
         g.flags = m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u;
+        const bool slots = m.base_color_texture.used() || m.metallic_roughness_texture.used() ||
+                           m.normal_texture.used() || m.emissive_texture.used();
+        if (slots) g.flags |= MATERIAL_TEXTURED;
+        if (m.alpha_mode != AlphaMode::Opaque) g.flags |= MATERIAL_ALPHA_TESTED;
         data.materials.push_back(g);
         data.microfacet = data.microfacet || g.type != MATERIAL_LAMBERTIAN;
+        data.textured = data.textured || m.textured();
     }
     if (data.materials.empty()) data.materials.push_back(gpu::Material{});
 
     // Lights in emitter order, selected by power (PBRT 3rd ed. 13.3.1); each triangle records
     // its light so that a direction that hits it can ask the light strategy's density.
+    // Each scene triangle's packet lane, for the lights' TriangleSurface.
+    std::vector<uint32_t> lane_of_triangle(scene.triangle_count(), MCRT_NO_HIT);
+    for (size_t p = 0; p < bvh.packets.size(); ++p) {
+        for (int lane = 0; lane < MCRT_PACKET_WIDTH; ++lane) {
+            const uint32_t leaf = bvh.packets[p].index[lane];
+            if (leaf == MCRT_NO_HIT) continue;
+            lane_of_triangle[bvh.triangles[leaf].index] = uint32_t(p * MCRT_PACKET_WIDTH) + lane;
+        }
+    }
     std::vector<EmissiveTriangle> emitters = collect_emitters(scene);
     std::vector<double> powers;
     std::vector<uint32_t> light_of_triangle(scene.triangle_count(), 0);
     for (const EmissiveTriangle& e : emitters) {
-        const Material& m = scene.materials[scene.triangle_material[e.triangle]];
+        const uint32_t material = scene.triangle_material[e.triangle];
+        const Material& m = scene.materials[material];
         const glm::vec3* p = &scene.positions[3 * size_t(e.triangle)];
         gpu::Light light{};
         light.p0 = to_float4(p[0]);
@@ -63,6 +176,10 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
         light.Le = to_float4(m.emission);
         light.area = e.area;
         light.flags = m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u;
+        if (m.emissive_texture.used() || m.alpha_mode != AlphaMode::Opaque)
+            light.flags |= MATERIAL_TEXTURED;
+        light.material = material;
+        light.surface = lane_of_triangle[e.triangle];
         data.lights.push_back(light);
         powers.push_back(e.power);
         light_of_triangle[e.triangle] = uint32_t(data.lights.size());
@@ -80,6 +197,28 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
             info.material = scene.triangle_material[scene_triangle];
             info.light = light_of_triangle[scene_triangle];
         }
+    }
+    if (data.textured) {
+        // What texture lookups read of each lane's triangle (unused lanes stay zero).
+        data.surfaces.assign(bvh.packets.size() * MCRT_PACKET_WIDTH, gpu::TriangleSurface{});
+        for (size_t t = 0; t < scene.triangle_count(); ++t) {
+            const uint32_t lane = lane_of_triangle[t];
+            if (lane == MCRT_NO_HIT) continue;
+            gpu::TriangleSurface& s = data.surfaces[lane];
+            for (size_t k = 0; k < 3; ++k) {
+                const size_t corner = 3 * t + k;
+                if (corner < scene.texcoords.size()) {
+                    const glm::vec4& uv = scene.texcoords[corner];
+                    s.uv[k] = {uv.x, uv.y, uv.z, uv.w};
+                }
+                if (corner < scene.normals.size()) s.normal[k] = to_float4(scene.normals[corner]);
+                if (corner < scene.tangents.size()) {
+                    const glm::vec4& tg = scene.tangents[corner];
+                    s.tangent[k] = {tg.x, tg.y, tg.z, tg.w};
+                }
+            }
+        }
+        data.textures = texture_words(scene);
     }
     data.camera = make_gpu_camera(camera, width, height);
     return data;
@@ -143,6 +282,8 @@ GpuSceneBuffers::GpuSceneBuffers(const DeviceContext& device, const GpuSceneData
     lights = upload(device, data.lights, bytes, "lights");
     light_selection = upload(device, light_selection_words(data, &light_tree_nodes), bytes,
                              "light selection data");
+    surfaces = upload(device, data.surfaces, bytes, "texture coordinates and tangents");
+    textures = upload(device, data.textures, bytes, "textures");
     camera = upload(device, std::vector<gpu::CameraGpu>{data.camera}, bytes, "camera");
     light_count = cl_uint(data.lights.size());
 }

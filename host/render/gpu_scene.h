@@ -34,6 +34,13 @@ struct GpuSceneData {
     // Some material's type is not MATERIAL_LAMBERTIAN: the kernels need that model (-D
     // MCRT_MATERIALS_GLTF); a Lambertian scene's kernels are built without it.
     bool microfacet = false;
+    // Some material has a texture or tests alpha (Material::textured): the kernels need texture
+    // lookups (-D MCRT_TEXTURES), and these two arrays; an untextured scene leaves them empty.
+    bool textured = false;
+    std::vector<gpu::TriangleSurface> surfaces;  // per packet lane, as triangle_info
+    // TextureHeader, the materials' MaterialTextures, the TextureImageGpu table, the decode
+    // tables and the texels, in 32-bit words (RENDER_ARG_TEXTURES).
+    std::vector<uint32_t> textures;
 };
 
 // The camera of DESIGN.md's camera contract for an image of width × height.
@@ -55,7 +62,8 @@ std::vector<uint32_t> light_selection_words(const GpuSceneData& data, uint32_t* 
 // Device copies of GpuSceneData (empty arrays get a one-element buffer, never a null one).
 struct GpuSceneBuffers {
     GpuSceneBuffers(const DeviceContext& device, const GpuSceneData& data);
-    cl::Buffer nodes, packets, triangle_info, materials, lights, light_selection, camera;
+    cl::Buffer nodes, packets, triangle_info, materials, lights, light_selection, surfaces,
+        textures, camera;
     cl_uint light_count = 0;
     cl_uint light_tree_nodes = 0;
     size_t bytes = 0;

@@ -127,7 +127,7 @@ RenderVariants resolve_variants(const RenderSettings& settings) {
     return v;
 }
 
-std::string variant_program_options(const RenderVariants& v, bool microfacet) {
+std::string variant_program_options(const RenderVariants& v, bool microfacet, bool textured) {
     std::string options = std::string("-cl-std=CL1.2 -D MCRT_ESTIMATE=") + v.estimator.function;
     if (v.ambient()) options += " -D MCRT_AMBIENT_ESTIMATOR";
     options += std::string(" -D ") + v.light_select->macro;
@@ -137,6 +137,9 @@ std::string variant_program_options(const RenderVariants& v, bool microfacet) {
     options += std::string(" -D ") + (v.uses(kUsesMisHeuristic) ? v.mis_heuristic->macro
                                                                : kMisHeuristicVariants[0].macro);
     if (microfacet && v.materials->macro) options += std::string(" -D ") + v.materials->macro;
+    // Texture lookups and alpha tests only for a scene that has them (DESIGN.md "Radiometric
+    // contract": model no more than a scene needs).
+    if (textured) options += " -D MCRT_TEXTURES";
     return options;
 }
 

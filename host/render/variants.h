@@ -118,8 +118,10 @@ struct RenderVariants {
 RenderVariants resolve_variants(const RenderSettings& settings);
 
 // The -D options of the render program for these variants; `microfacet`: the scene has a
-// surface that is not Lambertian.
-std::string variant_program_options(const RenderVariants& variants, bool microfacet);
+// surface that is not Lambertian; `textured`: a material with a texture or alpha test
+// (-D MCRT_TEXTURES).
+std::string variant_program_options(const RenderVariants& variants, bool microfacet,
+                                    bool textured);
 
 // The rows' names, in table order (CLI11's IsMember, --help, the tests).
 template <typename Row>
