@@ -2,6 +2,8 @@
 // typed values of a buffer view read as doubles, every byte range checked first.
 #include "scene/gltf_accessors.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 
@@ -207,6 +209,56 @@ std::vector<double> read_accessor(const tinygltf::Model& model, int index,
     return values;
 }
 
+// A componentType with its normalized flag, as an attribute's accessor may have it.
+struct ComponentFormat {
+    int component_type;
+    bool normalized;
+};
+
+constexpr ComponentFormat kFloat{TINYGLTF_COMPONENT_TYPE_FLOAT, false};
+constexpr ComponentFormat kNormalizedByte{TINYGLTF_COMPONENT_TYPE_BYTE, true};
+constexpr ComponentFormat kNormalizedUnsignedByte{TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, true};
+constexpr ComponentFormat kNormalizedShort{TINYGLTF_COMPONENT_TYPE_SHORT, true};
+constexpr ComponentFormat kNormalizedUnsignedShort{TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, true};
+
+// What a vertex attribute other than POSITION must be: its type (VEC2, ...), the component
+// formats it may use, and how a message says so.
+struct AttributeFormat {
+    int type;
+    std::vector<ComponentFormat> formats;
+    const char* description;  // "a VEC3 of floats ..."
+};
+
+// The components of attribute accessor `index`: of `format`, `vertex_count` elements, finite.
+std::vector<double> read_vertex_attribute(const tinygltf::Model& model, int index,
+                                          size_t vertex_count, const std::string& attribute,
+                                          const AttributeFormat& format,
+                                          const std::string& referrer, const Diagnostics& diag) {
+    const tinygltf::Accessor& accessor =
+        checked_at(model.accessors, index, "accessor", referrer, diag);
+    const std::string element = element_name("accessor", static_cast<size_t>(index));
+    const bool allowed =
+        std::any_of(format.formats.begin(), format.formats.end(), [&](const ComponentFormat& f) {
+            return f.component_type == accessor.componentType &&
+                   f.normalized == accessor.normalized;
+        });
+    if (accessor.type != format.type || !allowed) {
+        diag.fail(element, attribute + " must be " + format.description);
+    }
+    if (accessor.count != vertex_count) {
+        diag.fail(referrer, attribute + " (" + element + ") has " + std::to_string(accessor.count) +
+                                " values, POSITION has " + std::to_string(vertex_count));
+    }
+    const std::vector<double> values = read_accessor(model, index, referrer, diag);
+    const size_t components = components_per_element(accessor.type);
+    for (size_t i = 0; i < values.size(); ++i) {
+        if (!std::isfinite(values[i])) {
+            diag.fail(element, attribute + " " + std::to_string(i / components) + " is not finite");
+        }
+    }
+    return values;
+}
+
 }  // namespace
 
 std::vector<glm::dvec3> read_positions(const tinygltf::Model& model, int index,
@@ -260,6 +312,58 @@ std::vector<uint32_t> read_indices(const tinygltf::Model& model, int index, size
         indices[i] = static_cast<uint32_t>(values[i]);
     }
     return indices;
+}
+
+std::vector<glm::dvec2> read_texcoords(const tinygltf::Model& model, int index, size_t vertex_count,
+                                       const std::string& attribute, const std::string& referrer,
+                                       const Diagnostics& diag) {
+    const AttributeFormat format{
+        TINYGLTF_TYPE_VEC2,
+        {kFloat, kNormalizedUnsignedByte, kNormalizedUnsignedShort, kNormalizedByte,
+         kNormalizedShort, ComponentFormat{TINYGLTF_COMPONENT_TYPE_BYTE, false},
+         ComponentFormat{TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, false},
+         ComponentFormat{TINYGLTF_COMPONENT_TYPE_SHORT, false},
+         ComponentFormat{TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, false}},
+        "a VEC2 of floats or of normalized unsigned bytes or shorts (or, with "
+        "KHR_mesh_quantization, of 8/16-bit integers)"};
+    const std::vector<double> values =
+        read_vertex_attribute(model, index, vertex_count, attribute, format, referrer, diag);
+    std::vector<glm::dvec2> texcoords(vertex_count);
+    for (size_t v = 0; v < vertex_count; ++v) {
+        texcoords[v] = glm::dvec2(values[2 * v], values[2 * v + 1]);
+    }
+    return texcoords;
+}
+
+std::vector<glm::dvec3> read_normals(const tinygltf::Model& model, int index, size_t vertex_count,
+                                     const std::string& referrer, const Diagnostics& diag) {
+    const AttributeFormat format{TINYGLTF_TYPE_VEC3,
+                                 {kFloat, kNormalizedByte, kNormalizedShort},
+                                 "a VEC3 of floats (or, with KHR_mesh_quantization, of normalized "
+                                 "bytes or shorts)"};
+    const std::vector<double> values =
+        read_vertex_attribute(model, index, vertex_count, "NORMAL", format, referrer, diag);
+    std::vector<glm::dvec3> normals(vertex_count);
+    for (size_t v = 0; v < vertex_count; ++v) {
+        normals[v] = glm::dvec3(values[3 * v], values[3 * v + 1], values[3 * v + 2]);
+    }
+    return normals;
+}
+
+std::vector<glm::dvec4> read_tangents(const tinygltf::Model& model, int index, size_t vertex_count,
+                                      const std::string& referrer, const Diagnostics& diag) {
+    const AttributeFormat format{TINYGLTF_TYPE_VEC4,
+                                 {kFloat, kNormalizedByte, kNormalizedShort},
+                                 "a VEC4 of floats (or, with KHR_mesh_quantization, of normalized "
+                                 "bytes or shorts)"};
+    const std::vector<double> values =
+        read_vertex_attribute(model, index, vertex_count, "TANGENT", format, referrer, diag);
+    std::vector<glm::dvec4> tangents(vertex_count);
+    for (size_t v = 0; v < vertex_count; ++v) {
+        tangents[v] =
+            glm::dvec4(values[4 * v], values[4 * v + 1], values[4 * v + 2], values[4 * v + 3]);
+    }
+    return tangents;
 }
 
 }  // namespace mcrt::gltf

@@ -1,5 +1,6 @@
 // Mesh primitives ("Meshes") as world-space triangles of mcrt's Scene: topology, mirroring
-// transforms, the emitted power of each emitter, and duplicate emitters merged.
+// transforms, the corners' texture attributes, the emitted power of each emitter, and duplicate
+// emitters merged.
 #include "scene/gltf_geometry.h"
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <unordered_map>
 
 #include "scene/gltf_accessors.h"
+#include "scene/gltf_attributes.h"
 #include "scene/gltf_limits.h"
 
 namespace mcrt::gltf {
@@ -36,6 +38,25 @@ std::vector<uint32_t> triangle_list(int mode, const std::vector<uint32_t>& ids) 
         }
     }
     return corners;
+}
+
+// The first textured primitive gives the scene its corner attributes: the corners before it are
+// of untextured materials and read none (zero).
+void start_corner_attributes(Scene& scene) {
+    scene.texcoords.assign(scene.positions.size(), glm::vec4(0.0f));
+    scene.normals.assign(scene.positions.size(), glm::vec3(0.0f));
+    scene.tangents.assign(scene.positions.size(), glm::vec4(0.0f));
+}
+
+// Corner `corner` of `attributes` appended to the scene's; zero for what the primitive's
+// material does not read.
+void append_corner_attributes(Scene& scene, const CornerAttributes& attributes, size_t corner) {
+    auto at = [corner](const auto& values, auto zero) {
+        return values.empty() ? zero : values[corner];
+    };
+    scene.texcoords.push_back(at(attributes.texcoords, glm::vec4(0.0f)));
+    scene.normals.push_back(at(attributes.normals, glm::vec3(0.0f)));
+    scene.tangents.push_back(at(attributes.tangents, glm::vec4(0.0f)));
 }
 
 // The same emissive triangle twice (same material, same corners in the same winding; either
@@ -81,14 +102,28 @@ void merge_duplicate_emitters(Scene& scene, Diagnostics& diag) {
         if (!seen.emplace(key_of(t), t).second) drop[t] = 1, ++dropped;
     }
     if (dropped == 0) return;
+    // The corner attributes move with their positions.
+    const bool textured = scene.textured();
     size_t kept = 0;
     for (size_t t = 0; t < scene.triangle_count(); ++t) {
         if (drop[t]) continue;
-        for (int c = 0; c < 3; ++c) scene.positions[3 * kept + c] = scene.positions[3 * t + c];
+        for (size_t c = 0; c < 3; ++c) {
+            scene.positions[3 * kept + c] = scene.positions[3 * t + c];
+            if (textured) {
+                scene.texcoords[3 * kept + c] = scene.texcoords[3 * t + c];
+                scene.normals[3 * kept + c] = scene.normals[3 * t + c];
+                scene.tangents[3 * kept + c] = scene.tangents[3 * t + c];
+            }
+        }
         scene.triangle_material[kept++] = scene.triangle_material[t];
     }
     scene.positions.resize(3 * kept);
     scene.triangle_material.resize(kept);
+    if (textured) {
+        scene.texcoords.resize(3 * kept);
+        scene.normals.resize(3 * kept);
+        scene.tangents.resize(3 * kept);
+    }
     diag.warn_once("duplicate-emitters",
                    std::to_string(dropped) +
                        " emissive triangle(s) repeat another exactly (same corners and material); "
@@ -125,14 +160,17 @@ void GeometryImporter::add_primitive(const tinygltf::Primitive& primitive,
     }
 
     // Geometry in the node's frame, checked again after the transform.
-    std::vector<glm::dvec3> positions = read_positions(model_, position->second, element, diag_);
-    for (glm::dvec3& p : positions) {
-        p = glm::dvec3(world * glm::dvec4(p, 1.0));
+    const std::vector<glm::dvec3> local_positions =
+        read_positions(model_, position->second, element, diag_);
+    std::vector<glm::dvec3> positions(local_positions.size());
+    for (size_t v = 0; v < positions.size(); ++v) {
+        const glm::dvec3 p = glm::dvec3(world * glm::dvec4(local_positions[v], 1.0));
         if (!is_finite(p) || glm::any(glm::greaterThan(glm::abs(p), glm::dvec3(kMaxCoordinate)))) {
             diag_.fail(node_element, "transformed position of " + element +
                                          " is not finite or exceeds 1e30 in magnitude");
         }
         max_coordinate_ = std::max(max_coordinate_, max_component(glm::abs(p)));
+        positions[v] = p;
     }
     std::vector<uint32_t> ids(positions.size());
     if (primitive.indices != -1) {
@@ -152,11 +190,25 @@ void GeometryImporter::add_primitive(const tinygltf::Primitive& primitive,
     }
 
     // A mirroring transform turns counter-clockwise into clockwise: swap two corners so the
-    // front face stays the one the file means.
+    // front face stays the one the file means (and with them their attributes).
     const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
+    const std::array<size_t, 3> corner_order =
+        mirrored ? std::array<size_t, 3>{0, 2, 1} : std::array<size_t, 3>{0, 1, 2};
     const uint32_t material = materials_.slot(primitive.material, element);
     const Material& surface = scene_.materials[material];
     const double Le_luminance = luminance(surface.emission);
+
+    // The corners' texture attributes, once any primitive's material reads them.
+    const AttributeNeeds needs = attribute_needs(model_, primitive.material);
+    if (needs.texcoords && triangles > 0 && !corner_attributes_) {
+        start_corner_attributes(scene_);
+        corner_attributes_ = true;
+    }
+    CornerAttributes attributes;
+    if (needs.texcoords && corner_attributes_) {
+        attributes = read_corner_attributes(model_, primitive, needs, local_positions, corners,
+                                            world, element, diag_);
+    }
     for (size_t t = 0; t < triangles; ++t) {
         const uint32_t a = corners[3 * t], b = corners[3 * t + 1], c = corners[3 * t + 2];
         // An emitter's power, luminance(Le) × area × π (×2 double-sided), is a float in light
@@ -173,9 +225,10 @@ void GeometryImporter::add_primitive(const tinygltf::Primitive& primitive,
             }
             total_power_ += power;
         }
-        scene_.positions.push_back(glm::vec3(positions[a]));
-        scene_.positions.push_back(glm::vec3(positions[mirrored ? c : b]));
-        scene_.positions.push_back(glm::vec3(positions[mirrored ? b : c]));
+        for (size_t k : corner_order) {
+            scene_.positions.push_back(glm::vec3(positions[corners[3 * t + k]]));
+            if (corner_attributes_) append_corner_attributes(scene_, attributes, 3 * t + k);
+        }
         scene_.triangle_material.push_back(material);
     }
 }

@@ -16,7 +16,8 @@ namespace mcrt::gltf {
 void warn_morph_targets(Diagnostics& diag);
 
 // Appends each primitive's triangles, with their material slots, to `scene`, and keeps what the
-// whole scene is checked against once every primitive is in.
+// whole scene is checked against once every primitive is in. Once a primitive's material reads
+// textures, every corner also has its attributes (scene.h Scene::texcoords, normals, tangents).
 class GeometryImporter {
   public:
     GeometryImporter(const tinygltf::Model& model, Diagnostics& diag, MaterialTable& materials,
@@ -38,6 +39,8 @@ class GeometryImporter {
     Scene& scene_;
     double total_power_ = 0.0;     // of every emissive triangle instance, in double
     double max_coordinate_ = 0.0;  // largest |component| of a world position
+    // A textured primitive came: from then on every corner has attributes.
+    bool corner_attributes_ = false;
 };
 
 }  // namespace mcrt::gltf

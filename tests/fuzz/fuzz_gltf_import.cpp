@@ -27,6 +27,31 @@ void require(bool condition, const char* what) {
     std::abort();
 }
 
+// The corners' texture attributes (scene.h): none, or one of each per corner, finite; each frame
+// zero (no normal texture) or a unit normal and a unit tangent with w = ±1.
+void check_corner_attributes(const mcrt::Scene& scene) {
+    if (!scene.textured()) {
+        require(scene.normals.empty() && scene.tangents.empty(), "no frames without texcoords");
+        return;
+    }
+    const size_t corners = scene.positions.size();
+    require(scene.texcoords.size() == corners && scene.normals.size() == corners &&
+                scene.tangents.size() == corners,
+            "corner attributes parallel to positions");
+    auto unit = [](const glm::vec3& v) { return std::abs(glm::length(v) - 1.0f) < 1e-3f; };
+    for (size_t c = 0; c < corners; ++c) {
+        const glm::vec4& uv = scene.texcoords[c];
+        require(finite(glm::vec3(uv)) && std::isfinite(uv.w), "finite texcoords");
+        const glm::vec3& n = scene.normals[c];
+        const glm::vec4& t = scene.tangents[c];
+        if (n == glm::vec3(0.0f)) {
+            require(t == glm::vec4(0.0f), "no tangent without a normal");
+            continue;
+        }
+        require(unit(n) && unit(glm::vec3(t)) && std::abs(t.w) == 1.0f, "unit frames, w = ±1");
+    }
+}
+
 // What the renderer assumes of every scene load_gltf returns.
 void check_scene(const mcrt::Scene& scene) {
     require(scene.positions.size() == 3 * scene.triangle_count(), "three corners per triangle");
@@ -45,6 +70,7 @@ void check_scene(const mcrt::Scene& scene) {
             require(finite(glm::vec3(c.camera_to_world[i])), "finite camera");
     }
     require(finite(scene.bounds_min()) && finite(scene.bounds_max()), "finite bounds");
+    check_corner_attributes(scene);
     for (const mcrt::EmissiveTriangle& e : mcrt::collect_emitters(scene)) {
         require(e.triangle < scene.triangle_count(), "emitter in range");
         require(std::isfinite(e.area) && e.area > 0.0f, "finite positive emitter area");
