@@ -127,7 +127,8 @@ void write_bytes(const fs::path& path, const std::vector<char>& bytes) {
 namespace {
 // The render program's options for the default settings.
 std::string default_render_options() {
-    return mcrt::variant_program_options(mcrt::resolve_variants(mcrt::RenderSettings{}), false);
+    return mcrt::variant_program_options(mcrt::resolve_variants(mcrt::RenderSettings{}), false,
+                                         false);
 }
 }  // namespace
 
