@@ -729,9 +729,11 @@ def camera_rays(camera, w, h, jitter):
     return eye, d
 
 
-def view(scene, k):
-    """What camera k of `scene` must see at RESOLUTION: exact pixel means, labels and probes."""
-    w, h = RESOLUTION
+def exact_view(scene, k, resolution=RESOLUTION):
+    """(pixel means (H, W, 3), labels (H, W): the piece a pixel's grown footprint lies in, −1
+    where it straddles, or None for views without pieces, all samples (H, W, S, 3)) of camera
+    k of `scene`: DESIGN.md's pixels, q × q midpoint rule per pixel."""
+    w, h = resolution
     q = QUADRATURE
     g = (np.arange(q) + 0.5) / q
     jitter = np.stack(np.meshgrid(g, g, indexing="xy"), -1).reshape(-1, 2)
@@ -742,14 +744,21 @@ def view(scene, k):
     values, keys = evaluate(eye, d.reshape(-1, 3))
     values = values.reshape(h, w, -1, 3)
     mean = values[:, :, :q * q].mean(axis=2)
-    out = {"camera": k, "resolution": [w, h]}
     if k == 1:  # piecewise constant: a label per distinct radiance (RGB folded into one number)
         folded = np.round(values.reshape(-1, 3), 9) @ np.array([1.0, math.sqrt(2.0), math.pi])
         keys = np.unique(folded, return_inverse=True)[1]
+    labels = None
     if keys is not None:
         keys = np.asarray(keys).reshape(h, w, -1)
-        uniform = np.all(keys == keys[:, :, :1], axis=2)
-        labels = np.where(uniform, keys[:, :, 0], -1)
+        labels = np.where(np.all(keys == keys[:, :, :1], axis=2), keys[:, :, 0], -1)
+    return mean, labels, values
+
+
+def view(scene, k):
+    """What camera k of `scene` must see at RESOLUTION: exact pixel means, labels and probes."""
+    mean, labels, values = exact_view(scene, k)
+    out = {"camera": k, "resolution": list(RESOLUTION)}
+    if labels is not None:
         out.update(label_map(scene, k, labels, mean, values))
     else:
         out["image_mean"] = rounded(mean.reshape(-1, 3).mean(axis=0))
