@@ -63,7 +63,11 @@ inline float3 bent_normal(const TextureView* tv, global const MaterialTextures* 
     t = normalize(t);
     float3 b = cross(n, t) * (t4.w < 0.0f ? -1.0f : 1.0f);
     float3 c = texture_lookup(tv, &mt->normal, uv).xyz * 2.0f - 1.0f;
-    float3 ns = normalize((c.x * mt->normal_scale) * t + (c.y * mt->normal_scale) * b + c.z * n);
+    /* The texture's +u' and up (−v') directions in the frame of the untransformed coordinates:
+     * T' = cos·T − sin·B, B' = sin·T + cos·B for KHR_texture_transform's rotation. */
+    float x = mt->normal_cos * c.x + mt->normal_sin * c.y;
+    float y = mt->normal_cos * c.y - mt->normal_sin * c.x;
+    float3 ns = normalize((x * mt->normal_scale) * t + (y * mt->normal_scale) * b + c.z * n);
     if (!sp->front) ns = -ns;
     if (!(dot(ns, sp->ng) > 0.0f)) return sp->ng;
     /* Turned toward wo until wo is at least 0.01 above it. */

@@ -258,7 +258,10 @@ typedef struct {
     float normal_scale; /* normalTexture.scale */
     uint alpha_mode;    /* MATERIAL_ALPHA_* */
     float roughness;    /* roughnessFactor (Material.alpha is its square, clamped) */
-    uint pad0, pad1, pad2;
+    /* The normal texture's KHR_texture_transform rotation (cos, sin): the tangent frame follows
+     * the untransformed coordinates, so the texel's x and y are turned back by it. */
+    float normal_cos, normal_sin;
+    uint pad0;
 } MaterialTextures;
 
 /* One image of the texel data, 16 bytes: its texels, row by row from the top, one RGBA8 texel
@@ -384,6 +387,7 @@ enum RenderArgument {
     FIELD(MaterialTextures, emissive, 96) FIELD(MaterialTextures, base_alpha, 128)              \
     FIELD(MaterialTextures, alpha_cutoff, 132) FIELD(MaterialTextures, normal_scale, 136)       \
     FIELD(MaterialTextures, alpha_mode, 140) FIELD(MaterialTextures, roughness, 144)            \
+    FIELD(MaterialTextures, normal_cos, 148) FIELD(MaterialTextures, normal_sin, 152)           \
     TYPE(TextureImageGpu, 16, 4) FIELD(TextureImageGpu, offset, 0)                              \
     FIELD(TextureImageGpu, width, 4) FIELD(TextureImageGpu, height, 8)                          \
     TYPE(TextureHeader, 16, 4) FIELD(TextureHeader, materials, 0)                               \

@@ -14,6 +14,7 @@
 
 #include "common/error.h"
 #include "image/image_check.h"
+#include "image_bytes.h"
 #include "process_support.h"
 #include "scene/gltf_import.h"
 
@@ -23,27 +24,20 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string base64(const std::vector<unsigned char>& bytes) {
-    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    for (size_t i = 0; i < bytes.size(); i += 3) {
-        uint32_t v = uint32_t(bytes[i]) << 16;
-        if (i + 1 < bytes.size()) v |= uint32_t(bytes[i + 1]) << 8;
-        if (i + 2 < bytes.size()) v |= bytes[i + 2];
-        out += table[(v >> 18) & 63];
-        out += table[(v >> 12) & 63];
-        out += i + 1 < bytes.size() ? table[(v >> 6) & 63] : '=';
-        out += i + 2 < bytes.size() ? table[v & 63] : '=';
-    }
-    return out;
-}
+// Byte offset of the texture coordinates after the positions and `index_count` indices.
+size_t texcoord_offset(size_t index_count) { return (36 + 2 * index_count + 3) / 4 * 4; }
 
-// Buffer bytes: one triangle of half-size `s` in the xz plane (front face up), then indices.
-std::string triangle_buffer_uri(double s, const std::vector<uint16_t>& indices = {0, 1, 2}) {
+// Buffer bytes: one triangle of half-size `s` in the xz plane (front face up), then indices and,
+// with `texcoords`, its corners' TEXCOORD_0.
+std::string triangle_buffer_uri(double s, const std::vector<uint16_t>& indices = {0, 1, 2},
+                                bool texcoords = false) {
     const float p[9] = {float(-s), 0, float(s), float(s), 0, float(s), 0, 0, float(-s)};
-    std::vector<unsigned char> bytes(sizeof p + 2 * indices.size());
+    const float uv[6] = {0, 0, 1, 0, 0, 1};
+    std::vector<unsigned char> bytes(texcoords ? texcoord_offset(indices.size()) + sizeof uv
+                                               : sizeof p + 2 * indices.size());
     std::memcpy(bytes.data(), p, sizeof p);
     std::memcpy(bytes.data() + sizeof p, indices.data(), 2 * indices.size());
+    if (texcoords) std::memcpy(bytes.data() + texcoord_offset(indices.size()), uv, sizeof uv);
     return "data:application/octet-stream;base64," + base64(bytes);
 }
 
@@ -56,19 +50,29 @@ struct Gltf {
     double size = 1.0;
     std::vector<uint16_t> indices = {0, 1, 2};
     std::string buffer_uri;  // default: the triangle as a data uri
+    bool texcoords = false;  // the triangle has TEXCOORD_0 (accessor 2), as textured materials read
 
     std::string text() const {
-        const std::string uri = buffer_uri.empty() ? triangle_buffer_uri(size, indices) : buffer_uri;
-        const size_t length = 36 + 2 * indices.size();
+        const std::string uri =
+            buffer_uri.empty() ? triangle_buffer_uri(size, indices, texcoords) : buffer_uri;
+        const size_t uv_at = texcoord_offset(indices.size());
+        const size_t length = texcoords ? uv_at + 24 : 36 + 2 * indices.size();
+        const std::string uv_attribute = texcoords ? R"(, "TEXCOORD_0": 2)" : "";
+        const std::string uv_accessor =
+            texcoords ? R"(, {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2"})" : "";
+        const std::string uv_view =
+            texcoords ? R"(, {"buffer": 0, "byteOffset": )" + std::to_string(uv_at) + R"(, "byteLength": 24})"
+                      : "";
         return "{" + asset + "," + extra + R"("scene": 0, "scenes": [{"nodes": )" + scene_nodes +
                R"(}], "nodes": )" + nodes + R"(, "materials": [)" + material +
-               R"(], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+               R"(], "meshes": [{"primitives": [{"attributes": {"POSITION": 0)" + uv_attribute +
+               R"(}, "indices": 1, "material": 0}]}],
   "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"},
                 {"bufferView": 1, "componentType": 5123, "count": )" +
-               std::to_string(indices.size()) + R"(, "type": "SCALAR"}],
+               std::to_string(indices.size()) + R"(, "type": "SCALAR"})" + uv_accessor + R"(],
   "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
                   {"buffer": 0, "byteOffset": 36, "byteLength": )" +
-               std::to_string(2 * indices.size()) + R"(}],
+               std::to_string(2 * indices.size()) + "}" + uv_view + R"(],
   "buffers": [{"byteLength": )" + std::to_string(length) + R"(, "uri": ")" + uri + R"("}]})";
     }
 };
@@ -151,7 +155,7 @@ TEST_CASE("a uri or scene path naming a FIFO, directory or device is refused nam
     g.buffer_uri = "missing.bin";
     write_text(dir / "missing.gltf", g.text());
     require_render_refused(dir / "missing.gltf", "missing.bin : no such file");
-    // An image uri (textures are not used, but tinygltf reads the file) is no exception.
+    // An image uri (tinygltf reads every image file, used or not) is no exception.
     Gltf image;
     image.extra = R"("images": [{"uri": "fifo.bin"}],)";
     write_text(dir / "image.gltf", image.text());
@@ -189,6 +193,52 @@ TEST_CASE("a hierarchy expanding to 2^30 node instances is refused before expand
     big.nodes = few + "]";
     big.indices.assign(30000, 0);  // 10,000 (degenerate) triangles × 16,384 instances
     CHECK(refusal(big).find("triangles, more than") != std::string::npos);
+}
+
+TEST_CASE("textured scenes with damaged images or references are refused in one line",
+          "[gltf][hostile][textures]") {
+    TempDir dir("mcrt-hostile");
+    Gltf g;
+    g.texcoords = true;
+    g.material = R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}})";
+    auto scene_with = [&](const std::string& name, const std::string& images,
+                          const std::string& textures = R"([{"source": 0}])") {
+        Gltf s = g;
+        s.extra = R"("images": )" + images + R"(, "textures": )" + textures + ",";
+        write_text(dir / name, s.text());
+        return dir / name;
+    };
+    // A 1×1 grey PNG, then cut before its end.
+    const std::vector<unsigned char> png = png_file(1, 8, 0, {{128}});
+    write_text(dir / "truncated.png", std::string(png.begin(), png.end() - 20));
+    require_render_refused(scene_with("truncated.gltf", R"([{"uri": "truncated.png"}])"),
+                           "image 0 (truncated.png): the PNG is truncated");
+    // 65536 × 65536 declared by a valid IHDR, then garbage: refused before any texel is allocated.
+    std::vector<unsigned char> huge = png_signature();
+    const std::vector<unsigned char> ihdr = png_ihdr(65536, 65536, 8, 6);
+    huge.insert(huge.end(), ihdr.begin(), ihdr.end());
+    huge.insert(huge.end(), 100, 0xA5);
+    write_text(dir / "huge.png", std::string(huge.begin(), huge.end()));
+    require_render_refused(scene_with("huge.gltf", R"([{"uri": "huge.png"}])"),
+                           "image 0 (huge.png): 65536 × 65536 texels: more than the 16384 per side");
+    // An image uri naming a directory.
+    fs::create_directory(dir / "dir.png");
+    require_render_refused(scene_with("dir.gltf", R"([{"uri": "dir.png"}])"),
+                           "dir.png: is a directory; only regular files are read");
+    // Texture and image indices out of range.
+    write_text(dir / "good.png", std::string(png.begin(), png.end()));
+    require_render_refused(scene_with("texture_range.gltf", R"([{"uri": "good.png"}])", "[]"),
+                           "material 0 baseColorTexture: texture 0 out of range");
+    require_render_refused(
+        scene_with("image_range.gltf", R"([{"uri": "good.png"}])", R"([{"source": 1}])"),
+        "texture 0: source image 1 out of range");
+    // A KTX2 image (KHR_texture_basisu's): named by its extension.
+    const std::string ktx2 = "\xABKTX 20\xBB\r\n\x1A\n" + std::string(52, '\0');
+    write_text(dir / "image.ktx2", ktx2);
+    require_render_refused(
+        scene_with("ktx2.gltf", R"([{"uri": "image.ktx2", "mimeType": "image/ktx2"}])"),
+        "image 0 (image.ktx2): an image of KHR_texture_basisu (image/ktx2), which mcrt does not "
+        "implement");
 }
 
 // ---- class 3: values that overflow ------------------------------------------------------------

@@ -1,5 +1,5 @@
-// Textured surfaces against exact answers, on scenes built in code (the glTF import of the same
-// features is tested in test_gltf_textures.cpp):
+// Textured surfaces against exact answers, on scenes built in code (the same features read from
+// glTF files: test_textured_scenes.cpp):
 //  - a textured floor under a polygon light renders, pixel by pixel, its untextured image times
 //    the texel under the pixel (common random numbers: the two renders draw the same samples, so
 //    the ratio is exact to rounding), for each wrap mode, NEAREST, KHR_texture_transform and the

@@ -72,6 +72,11 @@ std::vector<uint32_t> texture_words(const Scene& scene) {
         t.normal_scale = m.normal_scale;
         t.alpha_mode = alpha_mode_bits(m.alpha_mode);
         t.roughness = m.roughness;
+        // The rotation of T·R·S, from its first column (sx cos r, −sx sin r).
+        const glm::vec2 column(m.normal_texture.row_u.x, m.normal_texture.row_v.x);
+        const float length = glm::length(column);
+        t.normal_cos = length > 0.0f ? column.x / length : 1.0f;
+        t.normal_sin = length > 0.0f ? -column.y / length : 0.0f;
         materials.push_back(t);
     }
     if (materials.empty()) materials.push_back(gpu::MaterialTextures{});

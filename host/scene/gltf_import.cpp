@@ -1,6 +1,7 @@
-// glTF 2.0 import: the default scene's triangles, metallic-roughness materials and perspective
-// cameras, each part read by its own file (gltf_parse, gltf_nodes, gltf_geometry, gltf_materials,
-// gltf_cameras); this one walks the scene and hands each node's content to them.
+// glTF 2.0 import: the default scene's triangles, metallic-roughness materials with their
+// textures and perspective cameras, each part read by its own file (gltf_parse, gltf_nodes,
+// gltf_geometry, gltf_materials, gltf_textures, gltf_images, gltf_cameras); this one walks the
+// scene and hands each node's content to them.
 //
 // tinygltf parses the file; it accepts out-of-range indices, node cycles and accessors that
 // overrun their data, so every part validates what it reads before it uses it. Quoted section
@@ -10,6 +11,7 @@
 #include "scene/gltf_cameras.h"
 #include "scene/gltf_diagnostics.h"
 #include "scene/gltf_geometry.h"
+#include "scene/gltf_images.h"
 #include "scene/gltf_materials.h"
 #include "scene/gltf_nodes.h"
 #include "scene/gltf_parse.h"
@@ -46,7 +48,8 @@ Scene import_default_scene(const tinygltf::Model& model, const std::string& path
     const gltf::RootNodes roots = gltf::root_nodes(model, diag);
     gltf::check_expansion(model, roots, diag);
 
-    gltf::MaterialTable materials(model, diag, scene.materials);
+    gltf::TextureTable textures(model, diag);
+    gltf::MaterialTable materials(model, diag, textures, scene.materials);
     gltf::GeometryImporter geometry(model, diag, materials, scene);
     gltf::traverse(model, roots, diag, [&](int node_index, const glm::dmat4& world) {
         const tinygltf::Node& node = model.nodes[static_cast<size_t>(node_index)];
@@ -71,6 +74,8 @@ Scene import_default_scene(const tinygltf::Model& model, const std::string& path
         }
     });
     geometry.finish();
+    // The images the used materials' texture slots name, once the walk has found them all.
+    scene.images = gltf::decode_images(model, textures.image_sources(), diag);
     return scene;
 }
 

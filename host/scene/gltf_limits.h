@@ -15,5 +15,10 @@ constexpr size_t kMaxFileBytes = size_t(4) << 30;       // the scene file and ea
 // the bench camera renders for S ≤ 2e12, partly at 4e12, not at 7e12 (ROBUSTNESS.md "Silently
 // wrong input"); the bound keeps a factor 200 of margin. Such scenes load with one warning.
 constexpr double kWarnCoordinate = 1e10;
+// Decoded texture images (gltf_images.cpp), checked from each image's header before any texel is
+// allocated: at most 16384 texels per side (1 GiB as RGBA; the textured sample scenes stop at
+// 2048), and 2^30 texels (4 GiB) over all the images a scene's materials use.
+constexpr unsigned kMaxImageSide = 16384;
+constexpr unsigned long long kMaxImageTexels = 1ull << 30;
 
 }  // namespace mcrt::gltf

@@ -1,5 +1,6 @@
 // glTF materials as mcrt's Material: the metallic-roughness factors (glTF 2.0 Appendix B),
-// emission with KHR_materials_emissive_strength, KHR_materials_specular; what is ignored warned.
+// emission with KHR_materials_emissive_strength, KHR_materials_specular, the alpha mode and the
+// texture slots (gltf_textures.cpp); what is ignored warned.
 #include "scene/gltf_materials.h"
 
 #include <algorithm>
@@ -85,17 +86,55 @@ double emissive_strength(const tinygltf::Material& material, const std::string& 
     return strength;
 }
 
+// "Alpha Coverage": alphaMode OPAQUE (default), MASK or BLEND; alphaCutoff (default 0.5) a
+// finite number >= 0 (the schema's minimum), kept whatever the mode.
+void read_alpha(const tinygltf::Material& source, const std::string& element, Diagnostics& diag,
+                Material& material) {
+    material.alpha = unit_factor(source.pbrMetallicRoughness.baseColorFactor[3],
+                                 "baseColorFactor alpha", element, diag);
+    if (source.alphaMode == "OPAQUE") {
+        material.alpha_mode = AlphaMode::Opaque;
+    } else if (source.alphaMode == "MASK") {
+        material.alpha_mode = AlphaMode::Mask;
+    } else if (source.alphaMode == "BLEND") {
+        material.alpha_mode = AlphaMode::Blend;
+    } else {
+        diag.fail(element, "alphaMode \"" + source.alphaMode + "\" is not OPAQUE, MASK or BLEND");
+    }
+    if (!std::isfinite(source.alphaCutoff) || source.alphaCutoff < 0.0) {
+        diag.fail(element, "alphaCutoff must be a finite number >= 0");
+    }
+    material.alpha_cutoff = float(source.alphaCutoff);
+}
+
+// "Metallic-Roughness Material" and "Additional Textures": each slot multiplies its factor.
+// baseColor and emissive textures hold sRGB-encoded colour, metallicRoughness (B metallic, G
+// roughness) and normal textures linear values; normalTexture.scale scales the normal's x and y.
+void read_texture_slots(const tinygltf::Material& source, const std::string& element,
+                        TextureTable& textures, const Diagnostics& diag, Material& material) {
+    const auto& pbr = source.pbrMetallicRoughness;
+    material.base_color_texture =
+        textures.read(pbr.baseColorTexture, true, element + " baseColorTexture");
+    material.metallic_roughness_texture =
+        textures.read(pbr.metallicRoughnessTexture, false, element + " metallicRoughnessTexture");
+    material.normal_texture =
+        textures.read(source.normalTexture, false, element + " normalTexture");
+    material.emissive_texture =
+        textures.read(source.emissiveTexture, true, element + " emissiveTexture");
+    if (material.normal_texture.used()) {
+        if (!std::isfinite(source.normalTexture.scale)) {
+            diag.fail(element, "normalTexture.scale must be a finite number");
+        }
+        material.normal_scale = float(source.normalTexture.scale);
+    }
+}
+
 // What of a material mcrt does not render, once per kind.
 void warn_unsupported_parts(const tinygltf::Material& material, Diagnostics& diag) {
-    const auto& pbr = material.pbrMetallicRoughness;
-    if (pbr.baseColorTexture.index != -1 || pbr.metallicRoughnessTexture.index != -1 ||
-        material.normalTexture.index != -1 || material.occlusionTexture.index != -1 ||
-        material.emissiveTexture.index != -1) {
-        diag.warn_once("textures", "textures are not supported; material factors used alone");
-    }
-    if (material.alphaMode != "OPAQUE") {
-        diag.warn_once(
-            "alpha", "alphaMode " + material.alphaMode + " is not supported; surfaces are opaque");
+    if (material.occlusionTexture.index != -1) {
+        // A path tracer's light transport computes the occlusion such a map approximates.
+        diag.warn_once("occlusion",
+                       "occlusionTexture is not used: the light transport computes occlusion");
     }
     if (material.extensions.count("KHR_materials_transmission")) {
         diag.warn_once("transmission",
@@ -107,8 +146,8 @@ void warn_unsupported_parts(const tinygltf::Material& material, Diagnostics& dia
 }  // namespace
 
 MaterialTable::MaterialTable(const tinygltf::Model& model, Diagnostics& diag,
-                             std::vector<Material>& materials)
-    : model_(model), diag_(diag), materials_(materials) {}
+                             TextureTable& textures, std::vector<Material>& materials)
+    : model_(model), diag_(diag), textures_(textures), materials_(materials) {}
 
 uint32_t MaterialTable::slot(int material_index, const std::string& referrer) {
     const auto found = slots_.find(material_index);
@@ -175,6 +214,8 @@ Material MaterialTable::convert(int material_index, const std::string& referrer)
     }
     material.double_sided = source.doubleSided;
     read_microfacet_factors(source, element, diag_, material);
+    read_alpha(source, element, diag_, material);
+    read_texture_slots(source, element, textures_, diag_, material);
     return material;
 }
 

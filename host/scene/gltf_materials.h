@@ -1,5 +1,7 @@
 // The glTF materials a scene uses, converted to mcrt's Material (DESIGN.md "Radiometric
-// contract"); textures, alpha and transmission are warned about and ignored.
+// contract"): factors, alpha mode and the base colour, metallic-roughness, normal and emissive
+// texture slots (their images decoded once the scene is walked, gltf_images.h). Occlusion
+// textures and transmission are warned about and ignored.
 #pragma once
 
 #include <tiny_gltf.h>
@@ -10,6 +12,7 @@
 #include <vector>
 
 #include "scene/gltf_diagnostics.h"
+#include "scene/gltf_textures.h"
 #include "scene/scene.h"
 
 namespace mcrt::gltf {
@@ -18,8 +21,9 @@ namespace mcrt::gltf {
 // a material's errors name the primitive that first refers to it.
 class MaterialTable {
   public:
-    // Converted materials are appended to `materials` (the Scene's).
-    MaterialTable(const tinygltf::Model& model, Diagnostics& diag,
+    // Converted materials are appended to `materials` (the Scene's); their texture slots are
+    // read through `textures`, which gives the images they use their Scene::images slots.
+    MaterialTable(const tinygltf::Model& model, Diagnostics& diag, TextureTable& textures,
                   std::vector<Material>& materials);
 
     // The slot in `materials` of glTF material `material_index` (−1: the default material);
@@ -31,6 +35,7 @@ class MaterialTable {
 
     const tinygltf::Model& model_;
     Diagnostics& diag_;
+    TextureTable& textures_;
     std::vector<Material>& materials_;
     std::map<int, uint32_t> slots_;  // glTF material index (−1: default) → slot
 };

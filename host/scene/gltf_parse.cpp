@@ -19,9 +19,8 @@ namespace mcrt::gltf {
 
 namespace {
 
-// Extensions whose every effect on mcrt's scene model is implemented (or, for texture
-// transforms, void since textures are ignored): a file may require them ("Specifying
-// Extensions": a loader must refuse a file requiring any other).
+// Extensions whose every effect on mcrt's scene model is implemented: a file may require them
+// ("Specifying Extensions": a loader must refuse a file requiring any other).
 const std::set<std::string> kSupportedRequiredExtensions = {
     "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_mesh_quantization",
     "KHR_texture_transform"};
@@ -33,9 +32,20 @@ bool has_glb_extension(const std::string& path) {
     return extension == ".glb";
 }
 
-// Textures are not used (DESIGN.md "Radiometric contract"): keep the image bytes undecoded.
-bool skip_image_decoding(tinygltf::Image*, const int, std::string*, std::string*, int, int,
-                         const unsigned char*, int, void*) {
+// tinygltf's image loader: the encoded bytes of a uri (its file or data URI) are kept in
+// Image::image for gltf_images.cpp, which decodes only the images materials use. A bufferView
+// image's bytes stay in their buffer: tinygltf hands them over without checking that the view
+// lies inside the buffer, so they are read only once gltf_images.cpp has checked it.
+bool keep_encoded_image(tinygltf::Image* image, const int index, std::string* error, std::string*,
+                        int, int, const unsigned char* bytes, int size, void*) {
+    if (size < 0) {  // tinygltf passes the size as an int
+        if (error) *error += "image " + std::to_string(index) + ": larger than 2 GiB";
+        return false;
+    }
+    if (image->bufferView == -1 && size > 0) {
+        image->image.assign(bytes, bytes + size);
+        image->as_is = true;
+    }
     return true;
 }
 
@@ -128,12 +138,12 @@ tinygltf::Model parse_gltf(const std::string& name, const std::vector<unsigned c
 
     access.base_prefix = base_dir + "/";
     tinygltf::TinyGLTF loader;
-    loader.SetImageLoader(skip_image_decoding, nullptr);
+    loader.SetImageLoader(keep_encoded_image, nullptr);
     loader.SetFsCallbacks(
         tinygltf::FsCallbacks{file_exists, path_unchanged, file_read, no_file_write, &access});
     const auto length = static_cast<unsigned int>(bytes.size());
     tinygltf::Model model;
-    std::string error, warning;  // tinygltf's warnings concern images and unknown data: dropped
+    std::string error, warning;  // tinygltf's warnings concern images and unknown data
     bool ok = false;
     try {
         ok = binary ? loader.LoadBinaryFromMemory(&model, &error, &warning, bytes.data(), length,
@@ -144,7 +154,8 @@ tinygltf::Model parse_gltf(const std::string& name, const std::vector<unsigned c
     } catch (const std::exception& e) {
         throw InputError(name + ": " + e.what());
     }
-    if (!ok) throw InputError(name + ": " + one_line(error));
+    // An empty image file fails with a warning alone as its reason.
+    if (!ok) throw InputError(name + ": " + one_line(error.empty() ? warning : error));
     if (!access.first_refusal.empty()) throw InputError(name + ": " + access.first_refusal);
     return model;
 }

@@ -98,6 +98,23 @@ class Checker {
         }
     }
 
+    // "Texture Data": a textureInfo, whose index tinygltf leaves at −1 (no texture) when it is
+    // missing, and its KHR_texture_transform.
+    void texture_info(const json& object, const std::string& where) const {
+        properties(object, where, {{"index", Kind::Integer}, {"texCoord", Kind::Integer},
+                                   {"scale", Kind::Number}, {"strength", Kind::Number},
+                                   {"extensions", Kind::Object}});
+        if (!object.contains("index")) {
+            throw InputError(name_ + ": " + where + ".index: required, an integer");
+        }
+        if (const auto ext = object.find("extensions"); ext != object.end()) {
+            if (const auto t = ext->find("KHR_texture_transform"); t != ext->end())
+                properties(*t, where + ".extensions.KHR_texture_transform",
+                           {{"offset", Kind::NumberArray}, {"rotation", Kind::Number},
+                            {"scale", Kind::NumberArray}, {"texCoord", Kind::Integer}});
+        }
+    }
+
     [[noreturn]] void fail(const std::string& where, const char* expected, const json& v) const {
         throw InputError(name_ + ": " + where + ": expected " + expected + ", found " +
                          found_name(v));
@@ -140,17 +157,39 @@ void check_gltf_property_types(const std::string& name, const unsigned char* dat
     c.array_of_objects(root, "materials", "", [&](const json& m, const std::string& at) {
         c.properties(m, at, {{"pbrMetallicRoughness", Kind::Object},
                              {"emissiveFactor", Kind::NumberArray}, {"doubleSided", Kind::Boolean},
-                             {"alphaMode", Kind::String}, {"extensions", Kind::Object}});
-        if (const auto pbr = m.find("pbrMetallicRoughness"); pbr != m.end())
+                             {"alphaMode", Kind::String}, {"alphaCutoff", Kind::Number},
+                             {"normalTexture", Kind::Object}, {"occlusionTexture", Kind::Object},
+                             {"emissiveTexture", Kind::Object}, {"extensions", Kind::Object}});
+        for (const char* slot : {"normalTexture", "occlusionTexture", "emissiveTexture"})
+            if (const auto info = m.find(slot); info != m.end())
+                c.texture_info(*info, at + "." + slot);
+        if (const auto pbr = m.find("pbrMetallicRoughness"); pbr != m.end()) {
             c.properties(*pbr, at + ".pbrMetallicRoughness",
                          {{"baseColorFactor", Kind::NumberArray}, {"metallicFactor", Kind::Number},
-                          {"roughnessFactor", Kind::Number}});
+                          {"roughnessFactor", Kind::Number}, {"baseColorTexture", Kind::Object},
+                          {"metallicRoughnessTexture", Kind::Object}});
+            for (const char* slot : {"baseColorTexture", "metallicRoughnessTexture"})
+                if (const auto info = pbr->find(slot); info != pbr->end())
+                    c.texture_info(*info, at + ".pbrMetallicRoughness." + slot);
+        }
         if (const auto ext = m.find("extensions"); ext != m.end()) {
             const auto strength = ext->find("KHR_materials_emissive_strength");
             if (strength != ext->end())
                 c.properties(*strength, at + ".extensions.KHR_materials_emissive_strength",
                              {{"emissiveStrength", Kind::Number}});
         }
+    });
+    c.array_of_objects(root, "textures", "", [&](const json& t, const std::string& at) {
+        c.properties(t, at, {{"sampler", Kind::Integer}, {"source", Kind::Integer},
+                             {"extensions", Kind::Object}});
+    });
+    c.array_of_objects(root, "samplers", "", [&](const json& t, const std::string& at) {
+        c.properties(t, at, {{"magFilter", Kind::Integer}, {"minFilter", Kind::Integer},
+                             {"wrapS", Kind::Integer}, {"wrapT", Kind::Integer}});
+    });
+    c.array_of_objects(root, "images", "", [&](const json& i, const std::string& at) {
+        c.properties(i, at, {{"uri", Kind::String}, {"mimeType", Kind::String},
+                             {"bufferView", Kind::Integer}});
     });
     c.array_of_objects(root, "accessors", "", [&](const json& a, const std::string& at) {
         c.properties(a, at, {{"bufferView", Kind::Integer}, {"byteOffset", Kind::Integer},

@@ -13,6 +13,7 @@ import json
 import math
 import struct
 import sys
+import zlib
 from pathlib import Path
 
 FLOAT, UBYTE, USHORT, UINT = 5126, 5121, 5123, 5125
@@ -221,10 +222,21 @@ def mirrored_matrix_emitter():
     return g
 
 
+def png_1x1(rgb):
+    """A 1×1 RGB PNG: signature, IHDR, one IDAT, IEND."""
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+    ihdr = struct.pack(">IIBBBBB", 1, 1, 8, 2, 0, 0, 0)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) +
+            chunk(b"IDAT", zlib.compress(bytes([0, *rgb]))) + chunk(b"IEND", b""))
+
+
 def texture_reference():
-    """Two materials with textures (warned about once) and one with an emissive strength."""
+    """Two materials sharing one texture (a 1×1 PNG, decoded once), one with an emissive
+    strength."""
     g = Gltf()
-    g.doc["images"] = [{"uri": "data:image/png;base64,iVBORw0KGgo="}]
+    png = base64.b64encode(png_1x1((255, 128, 0))).decode()
+    g.doc["images"] = [{"uri": "data:image/png;base64," + png}]
     g.doc["textures"] = [{"source": 0}]
     textured = g.material(name="textured",
                           pbrMetallicRoughness={"baseColorFactor": [0.5, 0.25, 0.125, 1.0],
@@ -232,9 +244,12 @@ def texture_reference():
     normal_mapped = g.material(**dict(emissive(strength=4.0), name="normal_mapped",
                                       normalTexture={"index": 0}))
     position = g.positions(TRIANGLE)
-    mesh = g.mesh(primitive(position, g.indices([0, 1, 2]), textured),
-                  primitive(position, g.indices([0, 2, 1]), normal_mapped))
-    g.scene([g.node(mesh=mesh)])
+    uv = g.accessor(g.view(struct.pack("<6f", 0, 0, 1, 0, 0, 1)), FLOAT, 3, "VEC2")
+    textured_primitive = primitive(position, g.indices([0, 1, 2]), textured)
+    normal_mapped_primitive = primitive(position, g.indices([0, 2, 1]), normal_mapped)
+    for p in (textured_primitive, normal_mapped_primitive):
+        p["attributes"]["TEXCOORD_0"] = uv
+    g.scene([g.node(mesh=g.mesh(textured_primitive, normal_mapped_primitive))])
     return g
 
 
