@@ -788,8 +788,9 @@ def label_map(scene, k, labels, mean, values):
             legend[ch] = {"radiance": rounded(values[first[0], first[1], 0])}
         chars[key] = ch
     rows = ["".join(chars.get(v, ".") for v in row) for row in labels]
-    meaning = ("ratio: pixel = ratio × the untextured twin's pixel (same camera); the texel whose "
-               "footprint covers the pixel" if k == 0 else
+    meaning = ("ratio: pixel = ratio × the untextured twin's pixel (same camera), ratio the "
+               "sRGB-decoded texel whose footprint covers the pixel (the twin has the same "
+               "baseColorFactor)" if k == 0 else
                "radiance: the pixel's exact value (light seen directly, through the occluder)")
     return {"labels": rows, "legend": legend, "label_meaning": meaning,
             "labelled_pixels": int(np.sum(labels >= 0))}

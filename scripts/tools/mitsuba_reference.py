@@ -650,10 +650,12 @@ class MaterialConversion:
             return {"type": "twosided", "material": {
                 "type": "roughconductor", "material": "none", "distribution": "ggx",
                 "alpha": alpha, "sample_visible": True, "specular_reflectance": base}}
+        what = ("its metallicRoughnessTexture mixes metal and dielectric" if metallic == 1.0
+                 else "metallic %g with a specular layer" % metallic)
         raise mcrt_run.ScriptError(
-            "%s: metallic %g with a specular layer: glTF's dielectric (a Lambertian base under a "
-            "Schlick-weighted GGX layer) has no Mitsuba 3 equivalent; use --materials lambert "
-            "or the approximate --materials principled" % (self.name, metallic))
+            "%s: %s: glTF's dielectric (a Lambertian base under a Schlick-weighted GGX layer) has "
+            "no Mitsuba 3 equivalent; use --materials lambert or the approximate --materials "
+            "principled" % (self.name, what))
 
     def radiance(self, textures, uv_range):
         """The area emitter's radiance: a constant or a texture."""
