@@ -20,6 +20,7 @@ namespace {
 const std::string kCornell = std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf";
 const std::string kGlossy = std::string(MCRT_SCENES) + "/glossy/cornell-metal-block.gltf";
 const std::string kVeach = std::string(MCRT_SCENES) + "/veach-mis/veach-mis.gltf";
+const std::string kTextured = std::string(MCRT_TEST_DATA) + "/textured/";
 
 // The first device of each platform, by index, keyed by platform name.
 std::map<std::string, int> one_device_per_platform() {
@@ -49,6 +50,10 @@ TEST_CASE("every OpenCL implementation renders the same bytes, alone and togethe
         {"depth-8 paths", kCornell, {"--estimator", "mis", "--max-depth", "8"}},
         {"light tree, ambient sky", kCornell,
          {"--estimator", "light-solid-angle", "--light-select", "tree", "--sky", "0.3"}},
+        {"bilinear texture", kTextured + "checker_linear.gltf", {"--estimator", "mis"}},
+        {"masked occluder", kTextured + "mask_occluder.gltf", {"--estimator", "light-area"}},
+        {"blended light, depth 3", kTextured + "blend_texture_light.gltf",
+         {"--estimator", "mis", "--max-depth", "3"}},
     };
     TempDir dir;
     for (const Configuration& c : configurations) {

@@ -20,6 +20,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 CORNELL = ROOT / "scenes/cornell/CornellBox-Original.gltf"
 GLOSSY = ROOT / "scenes/glossy/cornell-metal-block.gltf"
+TEXTURED = ROOT / "tests/data/textured"
 
 DIRECT = ["hemisphere-uniform", "hemisphere-cosine", "bsdf", "light-area", "light-solid-angle", "mis"]
 AMBIENT = ["ambient-uniform", "ambient-cosine", "ambient-fibonacci"]
@@ -41,6 +42,17 @@ def configurations():
         path = ROOT.parent / "shared/scenes" / shared
         if path.exists():  # the larger third-party scenes, where present
             yield ("mis depth 3, %s" % path.stem, path, ["--estimator", "mis", "--max-depth", "3"])
+    for scene in ["checker_linear", "wrap_clamp_mirror", "emissive_light", "mask_occluder",
+                  "blend_texture_light"]:
+        yield ("mis depth 3, textured %s" % scene, TEXTURED / (scene + ".gltf"),
+               ["--estimator", "mis", "--max-depth", "3"])
+    for shared in ["textured/DamagedHelmet/DamagedHelmet.gltf",
+                   "textured/AlphaBlendModeTest/AlphaBlendModeTest.gltf",
+                   "textured/NormalTangentTest/NormalTangentTest.gltf"]:
+        path = ROOT.parent / "shared/scenes" / shared
+        if path.exists():
+            yield ("mis depth 3 under the sky, %s" % path.stem, path,
+                   ["--estimator", "mis", "--max-depth", "3", "--sky", "1"])
     for materials in ["gltf", "lambert"]:
         yield ("mis depth 8, %s" % materials, GLOSSY,
                ["--estimator", "mis", "--max-depth", "8", "--materials", materials])
