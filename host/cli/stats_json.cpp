@@ -6,6 +6,17 @@
 
 namespace mcrt {
 
+namespace {
+
+// Bytes of the scene's decoded images (8-bit RGBA).
+uint64_t texel_bytes(const Scene& scene) {
+    uint64_t bytes = 0;
+    for (const TextureImage& image : scene.images) bytes += image.rgba.size();
+    return bytes;
+}
+
+}  // namespace
+
 nlohmann::json render_stats_json(const RenderStatsInput& in) {
     const RenderOptions& o = in.options;
     const RenderResult& result = in.result;
@@ -57,6 +68,15 @@ nlohmann::json render_stats_json(const RenderStatsInput& in) {
         {"nonfinite_pixels", 0},  // run_render writes no image with any
         {"triangles", in.planned.scene.scene.triangle_count()},
         {"lights", gpu_scene.lights.size()},
+        {"seconds_scene_load", in.planned.scene.seconds_load},
+        // Texture data on each device: texels (4 bytes each) with the materials' slots and the
+        // decode tables, and the triangles' texture coordinates and tangents.
+        {"textures",
+         {{"textured", gpu_scene.textured},
+          {"images", in.planned.scene.scene.images.size()},
+          {"texel_bytes", texel_bytes(in.planned.scene.scene)},
+          {"device_bytes", gpu_scene.textures.size() * sizeof(uint32_t) +
+                               gpu_scene.surfaces.size() * sizeof(gpu::TriangleSurface)}}},
         // The 4-wide tree the kernels traverse; the binary SAH tree it collapses as binary_*.
         {"bvh",
          {{"nodes", bvh.nodes4.size()},

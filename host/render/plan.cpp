@@ -1,5 +1,7 @@
 #include "render/plan.h"
 
+#include <chrono>
+
 #include "common/error.h"
 
 namespace mcrt {
@@ -99,7 +101,10 @@ PlannedRender plan_render(const RenderRequest& request, const SceneSource& sourc
     r.plan = check_render_settings(request.settings, request.sky);
     const RenderVariants& v = r.plan.variants;
     const RenderSettings& s = r.plan.settings;
+    const auto load_start = std::chrono::steady_clock::now();
     r.scene.scene = read_scene(request.scene, source, warn);
+    r.scene.seconds_load =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
     Scene& scene = r.scene.scene;
     if (v.materials->lambertian) make_lambertian(scene.materials);
     r.scene.camera = choose_camera(scene, request.camera);

@@ -61,6 +61,7 @@ struct PreparedScene {
     Camera camera;
     Bvh bvh;
     GpuSceneData gpu;
+    double seconds_load = 0;  // reading the glTF file, its buffers and images (decoding them)
 };
 
 struct PlannedRender {
