@@ -92,11 +92,16 @@ inline Bytes png_file(uint32_t width, uint8_t depth, uint8_t colour_type,
     return png;
 }
 
-// A PNG that declares `width` × `height` RGBA texels and holds none: signature, IHDR, IEND.
-inline Bytes png_header_only(uint32_t width, uint32_t height) {
+// A PNG that declares `width` × `height` RGBA texels and holds none of them: signature, IHDR, an
+// IDAT of `idat_bytes` zeros (none when 0; never valid zlib), IEND.
+inline Bytes png_header_only(uint32_t width, uint32_t height, size_t idat_bytes = 0) {
     Bytes png = png_signature();
     const Bytes ihdr = png_ihdr(width, height, 8, 6);
     png.insert(png.end(), ihdr.begin(), ihdr.end());
+    if (idat_bytes > 0) {
+        const Bytes idat = png_chunk("IDAT", Bytes(idat_bytes, 0));
+        png.insert(png.end(), idat.begin(), idat.end());
+    }
     const Bytes iend = png_chunk("IEND", {});
     png.insert(png.end(), iend.begin(), iend.end());
     return png;

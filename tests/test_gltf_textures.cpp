@@ -591,9 +591,15 @@ TEST_CASE("damaged or oversized images are refused with one line naming them",
                        "image 0: 65536 × 65536 texels: more than the 16384 per side"));
         CHECK(contains(decode({png_header_only(16385, 1)}).error, "more than the 16384 per side"));
         CHECK(contains(decode({png_header_only(0, 4)}).error, "declares no texels"));
-        // Four 16384² images are 2^30 texels, the budget; a fifth, even 1×1, is over it.
-        std::vector<Bytes> five(4, png_header_only(16384, 16384));
-        five.push_back(png_header_only(1, 1));
+        // Within the limits, but too little data for what it declares: refused before stb_image
+        // would allocate the 64 MiB image.
+        CHECK(contains(decode({png_header_only(4096, 4096, 100)}).error,
+                       "image 0: the PNG's 100 bytes of IDAT data cannot hold the 4096 × 4096 "
+                       "texels it declares"));
+        // Four 16384² images are 2^30 texels, the budget; a fifth, even 1×1, is over it. (Each
+        // IDAT is just long enough to pass for 1 GiB of deflated samples: never decoded.)
+        std::vector<Bytes> five(4, png_header_only(16384, 16384, 1100000));
+        five.push_back(png_header_only(1, 1, 1));
         CHECK(contains(decode(five).error,
                        "image 4: the images the materials use hold 1073741825 texels"));
     }

@@ -115,14 +115,21 @@ void check_size(const Encoded& encoded, const Diagnostics& diag) {
     }
 }
 
+// Deflate's largest expansion: a 258-byte match costs at least 2 bits (RFC 1951 sec. 3.2.5), so
+// no compressed byte inflates to more than 1032.
+constexpr unsigned long long kMaxInflateRatio = 1032;
+
 // PNG's chunk layout (ISO/IEC 15948 sec. 5.3), walked before stb_image reads the file: IHDR
 // first (its size read and checked here, before anything else: stb_image refuses to report a
 // size it thinks too large), IEND reached within the bytes, no critical chunk stb_image does not
-// know. A file cut short is named here; stb_image would read on past its end as zeros.
+// know, and IDAT data that can inflate to the samples IHDR declares: stb_image allocates the whole
+// image before it finds too few, so 100 bytes declaring 16384² would cost it a gigabyte. A file
+// cut short is named here; stb_image would read on past its end as zeros.
 void walk_png_chunks(Encoded& encoded, const Diagnostics& diag) {
     const unsigned char* d = encoded.data;
     const size_t n = encoded.size;
     size_t at = 8;
+    unsigned long long sample_bits = 0, idat_bytes = 0;
     for (bool first = true;; first = false) {
         if (n - at < 12) {
             diag.fail(encoded.element, "the PNG is truncated: " + std::to_string(n) +
@@ -137,13 +144,27 @@ void walk_png_chunks(Encoded& encoded, const Diagnostics& diag) {
             encoded.width = big_endian_32(d + at + 8);
             encoded.height = big_endian_32(d + at + 12);
             check_size(encoded, diag);
+            const unsigned depth = d[at + 16], colour_type = d[at + 17];
+            const unsigned samples[7] = {1, 0, 3, 1, 2, 0, 4};  // per texel, by colour type
+            sample_bits = (unsigned long long)encoded.width * encoded.height * depth *
+                          (colour_type < 7 ? samples[colour_type] : 0);
         }
         if (length > n - at - 12) {
             diag.fail(encoded.element, "the PNG is truncated: its chunk at byte " +
                                            std::to_string(at) + " holds " + std::to_string(length) +
                                            " bytes, " + std::to_string(n - at - 12) + " remain");
         }
-        if (type == "IEND") return;
+        if (type == "IDAT") idat_bytes += length;
+        if (type == "IEND") {
+            if (idat_bytes * kMaxInflateRatio < sample_bits / 8) {
+                diag.fail(encoded.element, "the PNG's " + std::to_string(idat_bytes) +
+                                               " bytes of IDAT data cannot hold the " +
+                                               std::to_string(encoded.width) + " × " +
+                                               std::to_string(encoded.height) +
+                                               " texels it declares");
+            }
+            return;
+        }
         const bool critical = (d[at + 4] & 0x20) == 0;  // ancillary chunks: gAMA, iCCP, ... skipped
         if (critical && type != "IHDR" && type != "PLTE" && type != "IDAT" && type != "CgBI") {
             diag.fail(encoded.element, "the PNG holds a critical chunk of unknown type");
