@@ -529,11 +529,17 @@ namespace {
 // degenerate (collinear), 3 not emissive, 4 emissive with zero luminance (black).
 mcrt::Scene emitter_test_scene() {
     mcrt::Scene scene;
-    scene.materials = {
-        {"warm", glm::vec3(0.5f), glm::vec3(4.0f, 2.0f, 1.0f), false},
-        {"both", glm::vec3(0.5f), glm::vec3(1.0f), true},
-        {"grey", glm::vec3(0.5f), glm::vec3(0.0f), false},
+    auto material = [](const char* name, glm::vec3 Le, bool double_sided) {
+        mcrt::Material m;
+        m.name = name;
+        m.albedo = glm::vec3(0.5f);
+        m.emission = Le;
+        m.double_sided = double_sided;
+        return m;
     };
+    scene.materials = {material("warm", glm::vec3(4.0f, 2.0f, 1.0f), false),
+                       material("both", glm::vec3(1.0f), true),
+                       material("grey", glm::vec3(0.0f), false)};
     auto add = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c, uint32_t material) {
         scene.positions.insert(scene.positions.end(), {a, b, c});
         scene.triangle_material.push_back(material);
