@@ -25,5 +25,5 @@ kernel void trace_any(global const Bvh4Node* nodes, global const TrianglePacket*
     size_t g = get_global_id(0);
     if (g >= ray_count) return;
     Ray r = make_ray(origins[g].xyz, directions[g].xyz);
-    occluded[g] = bvh_any_hit(nodes, packets, &r, origins[g].w, MCRT_NO_HIT) ? 1u : 0u;
+    occluded[g] = bvh_any_hit(nodes, packets, &r, origins[g].w, MCRT_NO_HIT, 0) ? 1u : 0u;
 }
