@@ -154,9 +154,9 @@ def main():
                    help="also render textured Sponza to this PNG "
                    "(docs/figures/sponza-textured.png)")
     p.add_argument("--sponza-size", type=mcrt_run.image_size, default=(480, 320))
-    p.add_argument("--sponza-spp", type=int, default=256)
+    p.add_argument("--sponza-spp", type=int, default=64)
     p.add_argument("--sponza-depth", type=int, default=8)
-    p.add_argument("--sponza-exposure", type=float, default=1.0)
+    p.add_argument("--sponza-exposure", type=float, default=3.5)
     mcrt_run.add_mcrt_option(p)
     args = p.parse_args()
     mcrt_run.require("numpy", "matplotlib")
