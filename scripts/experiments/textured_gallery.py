@@ -74,9 +74,12 @@ VIEWS = {
     "NormalTangentMirrorTest": View("NormalTangentMirrorTest.gltf", (256, 192),
                                     front(-0.01, -0.07, 4.2, 35)),
     "TextureCoordinateTest": View("TextureCoordinateTest.gltf", (224, 224), front(0, 0, 4.4, 35)),
-    "TextureEncodingTest": View("TextureEncodingTest.gltf", (256, 160), front(0, 0.5, 26, 28)),
+    # A dimmer sky where the test patches are emitters, so that the white emissive labels
+    # stand out as in the screenshots.
+    "TextureEncodingTest": View("TextureEncodingTest.gltf", (256, 160), front(0, 0.5, 26, 28),
+                                sky=0.25),
     "TextureLinearInterpolationTest": View("TextureLinearInterpolationTest.gltf", (224, 224),
-                                           front(0, 0.5, 10, 32)),
+                                           front(0, 0.5, 10, 32), sky=0.25),
     "TextureSettingsTest": View("TextureSettingsTest.gltf", (240, 236), front(0, -0.6, 17, 35)),
     "TextureTransformMultiTest": View("TextureTransformMultiTest.gltf", (224, 230),
                                       front(0, -0.2, 4.2, 34)),
