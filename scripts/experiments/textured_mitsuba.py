@@ -18,7 +18,10 @@ layers: mcrt's of its samples, Mitsuba's of its 16 passes), over the whole image
 pixels with noise (the model; the sky seen directly is exactly 1 on both); the share of pixel
 values more than 4 standard errors apart and the mean z²; and per region — blocks of 16 × 16
 pixels — the number of blocks whose mean differs by more than 3 standard errors and the largest.
-Writes the difference images of mitsuba_reference.py to --out.
+For DamagedHelmet it also prints the pixel
+centres where the viewer is below the normal as Mitsuba's normalmap bends it (there Mitsuba's
+BSDF is 0 and mcrt turns the normal back), both images' means there and their share of the
+difference. Writes the difference images of mitsuba_reference.py to --out.
 
 Usage: scripts/experiments/textured_mitsuba.py --mitsuba-python /path/to/venv/bin/python
            [--scenes DIR] [--only sponza-1,helmet-3,...] [--spp-scale 1] [--mcrt BIN] [--out DIR]
@@ -69,8 +72,8 @@ def viewer_below_mitsuba_normal(path, view, width, height):
     bends it — the tangent-space normal in the frame (dp/du made orthogonal to the interpolated
     normal, n × that, n), green flipped where the tangent frame is mirrored, as
     mitsuba_reference.py converts it: Mitsuba's diffuse BSDF is 0 there, while mcrt turns the
-    normal back toward the viewer (docs/MATERIALS.md, "Normal textures"). Returns (count, model
-    pixels, the 16² block (x, y) holding most of them)."""
+    normal back toward the viewer (docs/MATERIALS.md, "Normal textures"). Returns the masks of
+    those pixels and of the model's."""
     gltf = mitsuba_reference.Gltf(path)
     eye = np.array([float(v) for v in view[1].split(",")])
     target = np.array([float(v) for v in view[2].split("=")[-1].split(",")])
@@ -99,13 +102,7 @@ def viewer_below_mitsuba_normal(path, view, width, height):
     ng = hits.geometric_normal()
     # Both sides shade the face toward the viewer: the frame turned to that side.
     side = np.sign((ng * wi).sum(-1)) * np.sign((bent * ng).sum(-1))
-    below = model & ((bent * wi).sum(-1) * side <= 0)
-    ys, xs = np.nonzero(below)
-    if not len(ys):
-        return 0, int(model.sum()), None
-    keys, counts = np.unique(np.stack([xs // BLOCK * BLOCK, ys // BLOCK * BLOCK], -1), axis=0,
-                             return_counts=True)
-    return int(below.sum()), int(model.sum()), tuple(keys[np.argmax(counts)])
+    return model & ((bent * wi).sum(-1) * side <= 0), model
 
 
 def analyse(mcrt_path, mitsuba_path, png):
@@ -220,10 +217,20 @@ def main():
                       res["blocks_beyond_3_sigma"], res["blocks"], largest[0],
                       100 * largest[1], largest[2], largest[3]), flush=True)
         if name.startswith("helmet") and "with" in mcrt_run.comma_list(args.normal_maps):
-            below, pixels, block = viewer_below_mitsuba_normal(path, view, width, height)
+            below, model = viewer_below_mitsuba_normal(path, view, width, height)
+            stem = out / ("%s-with-normal-maps" % name)
+            mc = mitsuba_reference.read_hwc(str(stem) + ".exr")[0]
+            mi = mitsuba_reference.read_hwc(str(stem) + "-mitsuba.exr")[0]
+            ys, xs = np.nonzero(below)
+            keys, counts = np.unique(np.stack([xs // BLOCK * BLOCK, ys // BLOCK * BLOCK], -1),
+                                     axis=0, return_counts=True)
+            block = keys[np.argmax(counts)] if len(ys) else ("—", "—")
+            share = (mc - mi)[below].sum() / (mc - mi)[model].sum()
             print("textured_mitsuba: %s: the viewer is below Mitsuba's bent normal at %d of the "
-                  "model's %d pixel centres (%.2f%%), most in the block at x %s, y %s"
-                  % (name, below, pixels, 100 * below / pixels, *(block or ("—", "—"))))
+                  "model's %d pixel centres (%.2f%%), most in the block at x %s, y %s; mean "
+                  "there mcrt %.4f, Mitsuba %.4f; %.0f%% of the model's summed difference"
+                  % (name, below.sum(), model.sum(), 100 * below.sum() / model.sum(), *block,
+                     mc[below].mean(), mi[below].mean(), 100 * share))
     return 0
 
 
