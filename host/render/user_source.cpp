@@ -642,7 +642,7 @@ void Checker::directives() {
                 if (a.kind == Kind::Ident && probes_files(a.text))
                     fail_at(a, a.text + ": an estimator file may not look for other files");
                 if (a.kind == Kind::Ident && a.text == "_Pragma")
-                    for (size_t p = j + 1; p < std::min(end, j + 4); ++p)
+                    for (size_t p = j + 1; p < std::min(tokens_.size(), j + 4); ++p)
                         if (tokens_[p].kind == Kind::String && hostile_pragma_word(tokens_[p].text))
                             fail_at(a, "_Pragma" + tokens_[p].text.substr(0, 40) +
                                            ": not a pragma an estimator file may use");
