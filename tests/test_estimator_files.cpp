@@ -245,3 +245,100 @@ TEST_CASE("every example estimator is unbiased on a polygon light over a plane",
                 CHECK(r.standard_error.x < 0.05 * exact.x);  // not vacuous
             }
 }
+
+namespace {
+
+const std::string kEstimateBody =
+    "float3 estimate(const SceneView* scene, const SurfacePoint* sp, const SampleStream* stream,\n"
+    "                uint* rays) {\n"
+    "    return (float3)(0.25f);\n"
+    "}\n";
+
+// `mcrt render` of the Cornell box with the estimator file `text`: exit 2 and exactly one
+// `mcrt: error:` line, which names FILE:LINE (or FILE alone when line is 0) and says `says`;
+// nothing written. Returns that line.
+std::string refused(const TempDir& tmp, const std::string& text, int line, const std::string& says) {
+    const std::string file = tmp / "user.cl";
+    std::ofstream(file, std::ios::binary) << text;
+    const std::string out = tmp / "x.exr";
+    ProcessResult r = run_mcrt(tmp, {"render", kCornell, "--out", out, "--estimator-file", file,
+                                     "--width", "8", "--height", "8", "--spp", "4", "--quiet"});
+    CHECK(r.exit_code == 2);
+    size_t first = r.err.find("mcrt: error: ");
+    REQUIRE(first != std::string::npos);
+    CHECK(r.err.find("mcrt: error: ", first + 1) == std::string::npos);
+    std::string error = r.err.substr(first, r.err.find('\n', first) - first);
+    INFO(error);
+    const std::string where = line > 0 ? file + ":" + std::to_string(line) + ": " : file;
+    CHECK(error.find(where) != std::string::npos);
+    CHECK(error.find(says) != std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(out));
+    return error;
+}
+
+}  // namespace
+
+TEST_CASE("an estimator file's includes other than \"api.cl\" are refused before any compiler runs",
+          "[estimator-file][cli][hostile]") {
+    TempDir tmp("mcrt-estimator-include");
+    // A path that exists nowhere: a compiler would say "file not found"; the check says why.
+    const std::string only = "may include only \"api.cl\"";
+    refused(tmp, "/* 1 */\n#include </nonexistent-mcrt/passwd>\n" + kEstimateBody, 2, only);
+    refused(tmp, "#define F \"/etc/passwd\"\n#include F\n" + kEstimateBody, 2, only);
+    // With MCRT_KERNEL_DIR set, mcrt's kernels come from disk; the user's path still goes nowhere.
+    setenv("MCRT_KERNEL_DIR", (std::string(MCRT_SOURCE_DIR) + "/kernels").c_str(), 1);
+    refused(tmp, "#include \"../../../etc/passwd\"\n" + kEstimateBody, 1, only);
+    unsetenv("MCRT_KERNEL_DIR");
+    refused(tmp, "\n\n#line 1 \"render.cl\"\n" + kEstimateBody, 3, "#line");
+}
+
+TEST_CASE("includes in comments and inactive regions are ignored and the file renders its image",
+          "[estimator-file][cli]") {
+    TempDir tmp("mcrt-estimator-include");
+    const std::string file = tmp / "commented.cl";
+    std::ofstream(file) << "// #include </etc/passwd>\n/* #include </etc/passwd> */\n#if 0\n"
+                           "#include </etc/passwd>\n#endif\n#include \"api.cl\"\n"
+                        << kEstimateBody;
+    const std::string plain = tmp / "plain.cl";
+    std::ofstream(plain) << kEstimateBody;
+    std::vector<std::string> common = {kCornell, "--width", "8", "--height", "8", "--spp", "4",
+                                       "--quiet", "--estimator-file"};
+    std::vector<std::string> a = {"render", "--out", tmp / "a.exr"}, b = {"render", "--out", tmp / "b.exr"};
+    a.insert(a.end(), common.begin(), common.end());
+    b.insert(b.end(), common.begin(), common.end());
+    a.push_back(file);
+    b.push_back(plain);
+    REQUIRE(run_mcrt(tmp, a).exit_code == 0);
+    REQUIRE(run_mcrt(tmp, b).exit_code == 0);
+    Image x = read_exr(tmp / "a.exr"), y = read_exr(tmp / "b.exr");
+    CHECK(x.rgb[0] > 0.0f);
+    CHECK(same_bits(x.rgb, y.rgb));
+}
+
+TEST_CASE("hostile estimator files are refused with one line naming the file's line, exit 2",
+          "[estimator-file][cli][hostile]") {
+    TempDir tmp("mcrt-estimator-hostile");
+    refused(tmp, kEstimateBody + std::string("/* a NUL */\0\n", 13), 5, "contains a NUL byte");
+    refused(tmp, "/* float3 estimate(int x) { } */\nfloat f(void) { return 0.0f; }\n", 0,
+            "defines no function float3 estimate");
+    refused(tmp, kEstimateBody + "kernel void render(global float* x) { }\n", 5,
+            "defines the kernel 'render'");
+    refused(tmp, "float g(int n) {\n    return n > 0 ? g(n - 1) : 0.0f;\n}\n" + kEstimateBody, 2,
+            "'g' calls itself: OpenCL C forbids recursion");
+    refused(tmp, "float h(int n);\nfloat g(int n) { return h(n); }\n"
+                 "float h(int n) { return n > 0 ? g(n - 1) : 0.0f; }\n" + kEstimateBody,
+            2, "'g' calls itself (through h)");
+    refused(tmp, "float3 estimate(const SceneView* scene, const SurfacePoint* sp,\n"
+                 "                const SampleStream* stream, uint* rays) {\n"
+                 "    float big[4194304];\n    big[*rays] = 1.0f;\n    return (float3)(big[3]);\n}\n",
+            3, "private arrays of 16777216 bytes");
+}
+
+TEST_CASE("a name the estimator file shares with mcrt's kernels is reported at the file's line",
+          "[estimator-file][cli]") {
+    // The compiler reports the conflict in render.cl (PoCL prints no note naming the first
+    // definition); the error names the user's line.
+    TempDir tmp("mcrt-estimator-redefinition");
+    refused(tmp, kEstimateBody + "\nfloat render(int x) { return 1.0f; }\n", 6,
+            "mcrt's kernels already define 'render'");
+}

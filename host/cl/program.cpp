@@ -45,15 +45,23 @@ static std::string quoted(const std::string& name) {
     return q + "\"";
 }
 
-// Expands `#include "name"` lines; a file already expanded is skipped the second time.
+// Expands `#include "name"` lines; a file already expanded is skipped the second time. A
+// replacement (a user's file, checked by render/user_source.h) is passed through verbatim: its
+// lines are never read as includes here.
 static void expand(const std::string& name, const KernelReplacements& replacements,
                    std::set<std::string>& seen, std::string& out) {
     if (!seen.insert(name).second) return;
     auto replaced = replacements.find(name);
     const std::string shown = replaced != replacements.end() ? replaced->second.name : name;
-    std::istringstream in(replaced != replacements.end() ? replaced->second.text
-                                                         : read_kernel_file(name));
     out += "#line 1 " + quoted(shown) + "\n";
+    if (replaced != replacements.end()) {
+        out += replaced->second.text;
+        // A last line without its new-line, or ending in a backslash (a splice), still ends
+        // before the next file's #line.
+        out += out.back() == '\n' ? "\n" : "\n\n";
+        return;
+    }
+    std::istringstream in(read_kernel_file(name));
     std::string line;
     int line_number = 0;
     while (std::getline(in, line)) {

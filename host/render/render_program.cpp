@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <regex>
+#include <map>
 #include <sstream>
 
 #include "common/error.h"
@@ -12,6 +12,7 @@
 #include "common/environment.h"
 #include "render/plan.h"
 #include "render/renderer.h"
+#include "render/user_source.h"
 #include "render/variants.h"
 #include "shared_types.h"
 
@@ -50,6 +51,47 @@ std::string first_error_in(const std::string& log, const std::string& file) {
     return "";
 }
 
+// A build error that the log reports in mcrt's own files while the estimator file caused it (a
+// name both define: PoCL prints "error: render.cl:13:13: conflicting types for 'render'" and no
+// note naming the first definition): "FILE:LINE: mcrt's kernels already define 'render'
+// (render.cl:13:13: conflicting types for 'render')" at the line where the file names it, else
+// "FILE: ..." with mcrt's first error. "" when the log has no error line.
+std::string error_caused_by(const std::string& log, const std::string& file,
+                            const std::string& source) {
+    std::istringstream in(log);
+    std::string line, first;
+    while (std::getline(in, line)) {
+        // A note naming the file and line (clang's "note: previous definition is here").
+        if (size_t at = line.find(file + ":"); at != std::string::npos &&
+                                               line.find("note") != std::string::npos && !first.empty()) {
+            size_t digits = at + file.size() + 1, end = digits;
+            while (end < line.size() && std::isdigit(static_cast<unsigned char>(line[end]))) ++end;
+            if (end > digits) return file + ":" + line.substr(digits, end - digits) + ": " + first;
+        }
+        if (first.empty() && line.find("error") != std::string::npos) {
+            first = line.rfind("error: ", 0) == 0 ? line.substr(7) : line;
+        }
+    }
+    if (first.empty()) return "";
+    std::map<std::string, int> names;
+    try {
+        names = check_user_source(file, source, kUserEstimatorFunction).file_scope_names;
+    } catch (const InputError&) {
+    }
+    // The first 'name' the message quotes that the file also declares at file scope.
+    for (size_t open = first.find('\''); open != std::string::npos;
+         open = first.find('\'', open + 1)) {
+        size_t close = first.find('\'', open + 1);
+        if (close == std::string::npos) break;
+        auto it = names.find(first.substr(open + 1, close - open - 1));
+        if (it != names.end())
+            return file + ":" + std::to_string(it->second) + ": mcrt's kernels already define '" +
+                   it->first + "' (" + first + ")";
+        open = close;
+    }
+    return file + ": mcrt's kernels fail to build with this estimator file (" + first + ")";
+}
+
 }  // namespace
 
 cl::Program render_program(const DeviceContext& device, const RenderPlan& plan) {
@@ -65,8 +107,10 @@ cl::Program render_program(const DeviceContext& device, const RenderPlan& plan) 
     } catch (const RuntimeError& e) {
         if (settings.estimator_file.empty()) throw;
         std::string what = e.what();
-        std::string error =
-            first_error_in(what.substr(what.find('\n') + 1), settings.estimator_file);
+        const std::string log = what.substr(what.find('\n') + 1);
+        std::string error = first_error_in(log, settings.estimator_file);
+        if (error.empty())
+            error = error_caused_by(log, settings.estimator_file, settings.estimator_source);
         if (error.empty()) throw;
         throw InputError(error + " (the estimator file; build log follows)\n" +
                          what.substr(what.find('\n') + 1));
@@ -84,16 +128,18 @@ std::string read_estimator_file(const std::string& path) {
     std::ostringstream text;
     text << in.rdbuf();
     if (!in) throw SettingError("estimator_file", path + ": cannot read");
+    // Checked before any compiler sees it: includes, #line, NUL bytes, kernels, recursion,
+    // private arrays (user_source.h); the text to compile has `#include "api.cl"` blanked.
+    UserSource checked = check_user_source(path, text.str(), kUserEstimatorFunction);
     // The kernel calls the user's function by name: say so before a compiler would, in mcrt's
     // own source, that it is missing.
-    static const std::regex definition(std::string("\\b") + kUserEstimatorFunction + "\\s*\\(");
-    if (!std::regex_search(text.str(), definition))
+    if (!checked.defines_function)
         throw SettingError("estimator_file", path + ": defines no function float3 " +
                                                  kUserEstimatorFunction +
                                                  "(const SceneView*, const SurfacePoint*, "
                                                  "const SampleStream*, uint*) "
                                                  "(docs/ESTIMATORS.md)");
-    return text.str();
+    return checked.text;
 }
 
 }  // namespace mcrt

@@ -1,0 +1,2 @@
+/* float3 estimate(void) */
+float3 f(void) { return 0; }
