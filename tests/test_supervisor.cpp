@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include "cli/supervisor.h"
 #include "hostile_support.h"
@@ -66,6 +67,24 @@ void require_one_error(int code, const std::string& log, const std::string& text
     REQUIRE(errors.size() == 1);
     CHECK(errors[0].find(text) != std::string::npos);
     CHECK(names_in(out_dir.path()).empty());
+}
+
+// The state letter of process `pid` (proc(5): R, S, T stopped, Z ...).
+char process_state(pid_t pid) {
+    const std::string stat = read_whole_file("/proc/" + std::to_string(pid) + "/stat");
+    const size_t paren = stat.rfind(')');
+    return paren != std::string::npos && paren + 2 < stat.size() ? stat[paren + 2] : '?';
+}
+
+// Waits until process `pid` is in (or, with `in` false, out of) state `state`; false after
+// `seconds`.
+bool wait_for_state(pid_t pid, char state, bool in, double seconds) {
+    const auto start = Clock::now();
+    while (seconds_since(start) < seconds) {
+        if ((process_state(pid) == state) == in) return true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return false;
 }
 
 }  // namespace
@@ -142,6 +161,27 @@ TEST_CASE("a render killed from outside with SIGKILL is one error line",
     const int status = child.wait(30);
     require_one_error(exit_code(status), child.output(), "the render was killed (SIGKILL: out of memory?)",
                       out);
+}
+
+TEST_CASE("Ctrl-Z stops the render with its supervisor and fg continues both",
+          "[supervisor][signals][cli]") {
+    // The render is in a process group of its own, so a terminal's SIGTSTP reaches only the
+    // supervisor, which stops it too; SIGCONT goes on with both.
+    TempDir src("mcrt-sup-src"), out("mcrt-sup-out"), logs("mcrt-sup-logs");
+    const std::string hang = estimator_file(src, "hang.cl", kHang);
+    Child child(render_args(out / "a.exr", hang), {}, logs / "log");
+    REQUIRE(child.wait_for_text(" spp ", 120));
+    const pid_t render = child.render_pid();
+    REQUIRE(render != child.pid());
+    child.signal(SIGTSTP);
+    CHECK(wait_for_state(child.pid(), 'T', true, 10));
+    CHECK(wait_for_state(render, 'T', true, 10));
+    child.signal(SIGCONT);
+    CHECK(wait_for_state(child.pid(), 'T', false, 10));
+    CHECK(wait_for_state(render, 'T', false, 10));
+    child.signal(SIGTERM);  // and it still stops
+    const int status = child.wait(60);
+    require_one_error(exit_code(status), child.output(), "stopped by SIGTERM", out);
 }
 
 TEST_CASE("a render that works exits as without the supervisor, with the same image",

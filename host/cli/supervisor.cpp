@@ -40,8 +40,20 @@ extern "C" void on_stop_signal(int sig) {
     g_signals = g_signals + 1;
 }
 
+// A terminal's Ctrl-Z (SIGTSTP), which reaches the supervisor's process group alone.
+volatile std::sig_atomic_t g_terminal_stop = 0;
+extern "C" void on_terminal_stop(int) { g_terminal_stop = 1; }
+bool g_terminal_stop_caught = false;
+
 // Only so that a child's exit interrupts poll(2) at once.
 extern "C" void on_child(int) {}
+
+void catch_terminal_stop() {
+    struct sigaction action {};
+    action.sa_handler = on_terminal_stop;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGTSTP, &action, nullptr);
+}
 
 const int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
 
@@ -62,6 +74,12 @@ void catch_stop_signals() {
         sigaction(sig, &action, nullptr);
         g_caught[sig] = true;
     }
+    struct sigaction tstp {};
+    sigaction(SIGTSTP, nullptr, &tstp);
+    if (tstp.sa_handler != SIG_IGN) {  // ignored where no shell does job control
+        catch_terminal_stop();
+        g_terminal_stop_caught = true;
+    }
     struct sigaction child {};
     child.sa_handler = on_child;
     child.sa_flags = SA_NOCLDSTOP;
@@ -76,9 +94,12 @@ void set_stop_signals(void (*action)(int)) {
         if (g_caught[sig]) std::signal(sig, action);
 }
 
+// The worker's stage, as its lines name it (report_to_supervisor).
+enum class Stage { kSetup, kLaunch, kServe, kWriting, kDone };
+
 // What the worker last said.
 struct WorkerStage {
-    std::string stage = "start";
+    Stage stage = Stage::kSetup;
     double time_limit = 0;
     bool bar = false;
     Clock::time_point launched;
@@ -98,11 +119,15 @@ void take_line(const std::string& line, WorkerStage& w) {
         int bar = 0;
         in >> w.time_limit >> bar;
         w.bar = bar != 0;
-        w.stage = word;
+        w.stage = Stage::kLaunch;
         w.launched = Clock::now();
-    } else if (!word.empty()) {
-        w.stage = word;
-        if (word == "done") set_stop_signals(SIG_IGN);  // as the worker does (stop_signals.h)
+    } else if (word == "serve") {
+        w.stage = Stage::kServe;
+    } else if (word == "writing") {
+        w.stage = Stage::kWriting;
+    } else if (word == "done") {
+        w.stage = Stage::kDone;
+        set_stop_signals(SIG_IGN);  // as the worker does (common/stop_signals.h)
     }
 }
 
@@ -135,7 +160,7 @@ std::string estimator_hint(const WorkerStage& w, const std::string& hint, const 
 
 void print_error(const WorkerStage& w, const std::string& message) {
     // The progress bar's line is left open while kernels run.
-    std::cerr << (w.stage == "launch" && w.bar ? "\n" : "") << "mcrt: error: "
+    std::cerr << (w.stage == Stage::kLaunch && w.bar ? "\n" : "") << "mcrt: error: "
               << (w.rank > 0 ? "rank " + std::to_string(w.rank) + ": " : "") << message
               << std::endl;
 }
@@ -143,7 +168,7 @@ void print_error(const WorkerStage& w, const std::string& message) {
 // Where a worker that did not stop within the grace period (`of_what`: after what) was stuck.
 std::string stuck_where(const WorkerStage& w, const std::string& of_what) {
     const std::string grace = seconds_text(kSupervisorGraceSeconds) + " s" + of_what;
-    if (w.stage == "launch")
+    if (w.stage == Stage::kLaunch)
         return "a launch on the devices did not return within " + grace +
                estimator_hint(w, "an estimator that does not return?",
                               "a kernel or an OpenCL driver that does not return");
@@ -153,11 +178,11 @@ std::string stuck_where(const WorkerStage& w, const std::string& of_what) {
 
 // Why a worker died of `sig`, where it was.
 std::string death_where(const WorkerStage& w) {
-    if (w.stage == "launch" || w.stage == "serve")
+    if (w.stage == Stage::kLaunch || w.stage == Stage::kServe)
         return std::string("while the devices ran the kernels") +
                estimator_hint(w, "user code that writes out of bounds, or a large private array?",
                               "a fault in mcrt's kernels or in the OpenCL driver");
-    if (w.stage == "writing") return "while writing the outputs (a bug in mcrt)";
+    if (w.stage == Stage::kWriting) return "while writing the outputs (a bug in mcrt)";
     return "while setting up the render: loading the scene, building kernels (a bug in mcrt or "
            "in the OpenCL driver)";
 }
@@ -179,7 +204,7 @@ int outcome(int status, int forwarded, const WorkerStage& w) {
         std::raise(sig);
         return 128 + sig;
     }
-    if (w.stage == "done") {
+    if (w.stage == Stage::kDone) {
         std::cerr << "mcrt: warning: "
                   << (w.rank > 0 ? "rank " + std::to_string(w.rank) + ": " : "")
                   << "the render died of " << signal_name(sig)
@@ -221,7 +246,7 @@ int supervise(pid_t pid, int fd) {
         if (const int sig = g_signal; sig != 0) {
             g_signal = 0;
             if (fd >= 0) read_reports(fd, pending, w);  // a "done" written before the signal
-            if (w.stage == "done" || w.stage == "serve") {
+            if (w.stage == Stage::kDone || w.stage == Stage::kServe) {
                 // Ignored, as the worker ignores it.
             } else if (forwarded == 0) {
                 ::kill(pid, sig);  // its interrupt guard stops the render and writes what is done
@@ -236,14 +261,28 @@ int supervise(pid_t pid, int fd) {
                 return 128 + sig;
             }
         }
-        if (forwarded != 0 && w.stage != "writing" && w.stage != "done" &&
+        if (g_terminal_stop) {
+            // Ctrl-Z: the worker stops with this process and goes on with it (POSIX job
+            // control); the time it was stopped does not count against the grace periods.
+            g_terminal_stop = 0;
+            const Clock::time_point stopped = Clock::now();
+            ::kill(pid, SIGSTOP);
+            std::signal(SIGTSTP, SIG_DFL);
+            std::raise(SIGTSTP);  // returns once continued (fg, bg, SIGCONT)
+            catch_terminal_stop();
+            ::kill(pid, SIGCONT);
+            const Clock::duration paused = Clock::now() - stopped;
+            forwarded_at += paused;
+            w.launched += paused;
+        }
+        if (forwarded != 0 && w.stage != Stage::kWriting && w.stage != Stage::kDone &&
             seconds_since(forwarded_at) > kSupervisorGraceSeconds) {
             kill_and_reap(pid, &status);
             print_error(w, "stopped by " + signal_abbreviation(forwarded) + ", but " +
                                stuck_where(w, "") + "; no image was written");
             return 1;
         }
-        if (w.stage == "launch" && w.time_limit > 0 &&
+        if (w.stage == Stage::kLaunch && w.time_limit > 0 &&
             seconds_since(w.launched) > w.time_limit + kSupervisorGraceSeconds) {
             kill_and_reap(pid, &status);
             print_error(w, "the time limit of " + seconds_text(w.time_limit) + " s passed, but " +
@@ -336,6 +375,7 @@ std::optional<int> supervise_render(int argc, char** argv) {
         for (int sig : kStopSignals)
             if (g_caught[sig]) std::signal(sig, SIG_DFL), g_caught[sig] = false;
         std::signal(SIGCHLD, SIG_DFL);
+        if (g_terminal_stop_caught) std::signal(SIGTSTP, SIG_DFL);
         if (const int sig = g_signal; sig != 0) std::raise(sig);
         return std::nullopt;
     }

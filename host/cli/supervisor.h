@@ -1,5 +1,6 @@
 // `mcrt render` in a supervised child process: the render (the worker) runs in a child of the
-// same executable, and the parent (the supervisor) only waits for it. Kernel code that never
+// same executable, and the parent (the supervisor) only waits for it (and passes a terminal's
+// Ctrl-Z on to it). Kernel code that never
 // returns cannot be stopped inside the process that runs it, and code that writes out of bounds
 // kills that process; the supervisor outlives both. It forwards a stop signal to the worker and
 // kills it when it has not stopped within a grace period, backs up the time limit the same way,
@@ -22,7 +23,6 @@ std::optional<int> supervise_render(int argc, char** argv);
 // The worker's side: one line to the supervisor (nothing in a process without one).
 //   "estimator PATH"   the estimator file the kernels run (for the messages)
 //   "rank N"           this worker is rank N of an MPI job
-//   "setup"            the render is setting up (scene, devices, kernels, other ranks)
 //   "launch T BAR"     kernels run on the devices; T the time limit in seconds (0: none), BAR 1
 //                      when a progress bar is drawn on stderr
 //   "serve"            a rank above 0: rank 0 decides when it stops, stop signals are ignored
