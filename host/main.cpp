@@ -1,8 +1,10 @@
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 
 #include "cl/build_child.h"
 #include "cli/cli.h"
+#include "cli/supervisor.h"
 #include "common/stop_signals.h"
 #include "common/test_hooks.h"
 #include "mpi/job.h"
@@ -12,6 +14,9 @@ int main(int argc, char** argv) {
     // else: it joins no MPI job and parses no options.
     if (argc == 4 && std::strcmp(argv[1], "build-program") == 0)
         return mcrt::run_build_program_child(argv[2], std::atoi(argv[3]));
+    // `mcrt render` runs in a supervised child of this executable (host/cli/supervisor.h),
+    // started before anything else: the child joins the MPI job and touches OpenCL itself.
+    if (const std::optional<int> status = mcrt::supervise_render(argc, argv)) return *status;
     mcrt::ignore_pipe_signals();
     mcrt::JobSession job;  // joins the MPI job under mpirun or srun (host/mpi/job.h)
     const int status = mcrt::run_cli(argc, argv);

@@ -111,6 +111,16 @@ class Child {
     bool timed_out() const { return timed_out_; }
     pid_t pid() const { return pid_; }
 
+    // The process that renders: `mcrt render` runs in a child of the supervisor (the pid this
+    // object started, host/cli/supervisor.h); its only child, read from /proc/PID/task/PID/children
+    // (proc(5)), or the pid itself when it has none.
+    pid_t render_pid() const {
+        std::istringstream children(read_whole_file("/proc/" + std::to_string(pid_) + "/task/" +
+                                                    std::to_string(pid_) + "/children"));
+        pid_t child = 0;
+        return children >> child ? child : pid_;
+    }
+
     // Waits until the child no longer catches `sig` (its SA_RESETHAND handler ran), reading
     // SigCgt in /proc/PID/status; false after `seconds`.
     bool wait_handler_reset(int sig, double seconds) const {

@@ -163,7 +163,7 @@ TEST_CASE("a write that fails names the reason, exits 1 and leaves no temporary 
             Child child(args, env, logs / "log");
             REQUIRE(child.wait_for_text("paused at before-write", 60));
             const struct rlimit limit = {4096, 4096};
-            REQUIRE(::prlimit(child.pid(), RLIMIT_FSIZE, &limit, nullptr) == 0);
+            REQUIRE(::prlimit(child.render_pid(), RLIMIT_FSIZE, &limit, nullptr) == 0);
             write_text(logs / "go", "");
             const int status = child.wait(60);
             const std::string err = child.output();

@@ -335,6 +335,34 @@ TEST_CASE("bad input under mpirun: every rank exits 2, with one error line", "[m
     }
 }
 
+TEST_CASE("an estimator that crashes under mpirun: an error line per rank naming the signal",
+          "[mpi][cli][supervisor]") {
+    // Each rank's supervisor (host/cli/supervisor.h) outlives its render's SIGSEGV: one line
+    // (rank 0's, then "rank 1: ..."), and mpirun ends the job with a non-zero status.
+    mpirun();
+    TempDir dir;
+    {
+        std::ofstream crash(dir / "crash.cl");
+        crash << "float3 estimate(const SceneView* scene, const SurfacePoint* sp,\n"
+                 "                const SampleStream* stream, uint* rays) {\n"
+                 "    *(global volatile int*)(0x10) = 1;\n    return (float3)(0.0f);\n}\n";
+    }
+    ProcessResult r = run_mpi(2,
+                              {"render", kCornell, "--out", dir / "x.exr", "--width", "16",
+                               "--height", "16", "--spp", "16", "--quiet", "--estimator-file",
+                               dir / "crash.cl"},
+                              dir, 60);
+    INFO("stderr: " << r.err);
+    CHECK(!r.timed_out);
+    CHECK(r.exit_code != 0);
+    const std::vector<std::string> errors = lines_starting_with(r.err, "mcrt: error:");
+    REQUIRE(!errors.empty());
+    CHECK(errors.size() <= 2);
+    for (const std::string& e : errors)
+        CHECK(e.find("died of signal 11 (SIGSEGV") != std::string::npos);
+    CHECK(!std::filesystem::exists(dir / "x.exr"));
+}
+
 TEST_CASE(
     "under mpirun a time limit or SIGINT to rank 0 stops every rank and writes the "
     "whole chunks done",

@@ -18,6 +18,7 @@
 
 #include "cl/binary_cache.h"
 #include "cl/program.h"
+#include "common/signal_name.h"
 #include "common/test_hooks.h"
 
 extern char** environ;
@@ -59,13 +60,6 @@ struct BuildDirectory {
         fs::remove_all(path, ignored);
     }
 };
-
-std::string signal_name(int sig) {
-    const char* text = sigdescr_np(sig);
-    const char* abbrev = sigabbrev_np(sig);
-    return "signal " + std::to_string(sig) + (abbrev ? std::string(" (SIG") + abbrev : " (") +
-           (text ? std::string(", ") + text : "") + ")";
-}
 
 // The last non-empty line of a compiler's dump, which often names what failed.
 std::string last_line(const std::string& text) {

@@ -15,6 +15,7 @@
 #include "cli/messages.h"
 #include "cli/progress.h"
 #include "cli/stats_json.h"
+#include "cli/supervisor.h"
 #include "cli/validators.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
@@ -218,6 +219,7 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     std::vector<std::string> inputs = {o.scene};
     if (!o.estimator_file.empty()) inputs.push_back(o.estimator_file);
     check_outputs(outputs, inputs);
+    if (!o.estimator_file.empty()) report_to_supervisor("estimator " + o.estimator_file);
     const RenderRequest request = render_request(o);
 
     FileBundle files;  // what the other ranks load the scene from
@@ -246,6 +248,9 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     RenderControl control;
     control.time_limit = o.time_limit;
     control.interrupted = &g_interrupted;
+    control.launching = [&] {
+        report_to_supervisor("launch " + std::to_string(o.time_limit) + (o.quiet ? " 0" : " 1"));
+    };
     InterruptGuard interrupt_guard;  // SIGINT / SIGTERM: stop and write what is done
     ProgressBar bar(!o.quiet, uint64_t(o.width) * o.height);
     const double seconds_to_render =
@@ -257,6 +262,7 @@ int render_here(const RenderOptions& o, RenderJob* job) {
         },
         control, print_warning, job ? job->remote_workers(print_warning) : RemoteWorkers{});
     bar.finish();
+    report_to_supervisor("writing");
     if (!result.stopped_by.empty())
         print_warning("stopped by " + result.stopped_by + " after " + std::to_string(result.spp) +
                       " of " + std::to_string(o.spp) + " samples per pixel; writing those");
@@ -301,12 +307,18 @@ int render_here(const RenderOptions& o, RenderJob* job) {
                   << result.spp << " spp, " << result.seconds_render << " s on the device)"
                   << std::endl;
     outputs_complete();
+    report_to_supervisor("done");
     return 0;
 }
 
 int render_in_job(const RenderOptions& o) {
     if (job_size() == 1) return render_here(o, nullptr);
-    if (job_rank() > 0) return serve_render(render_request(o), o.devices);
+    report_to_supervisor("rank " + std::to_string(job_rank()));
+    if (job_rank() > 0) {
+        if (!o.estimator_file.empty()) report_to_supervisor("estimator " + o.estimator_file);
+        report_to_supervisor("serve");  // rank 0 decides when this rank stops
+        return serve_render(render_request(o), o.devices);
+    }
     // Every rank exits with rank 0's status; its error line is printed by run_cli alone.
     RenderJob job;
     try {

@@ -12,6 +12,8 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <string>
 #include <system_error>
 
 #include "common/error.h"
@@ -101,6 +103,16 @@ bool write_unnamed(const fs::path& target, const fs::path& directory,
 #endif
 }
 
+// A process that has ended but is not yet reaped (state Z in /proc/PID/stat, proc(5)): a render
+// killed with its supervisor is an orphan until init reaps it, which can take seconds.
+bool is_zombie(pid_t pid) {
+    std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+    std::string stat;
+    std::getline(in, stat);
+    const size_t paren = stat.rfind(')');  // the command name may hold spaces and parentheses
+    return paren != std::string::npos && paren + 2 < stat.size() && stat[paren + 2] == 'Z';
+}
+
 }  // namespace
 
 int sweep_stale_temporaries(const std::string& path) {
@@ -112,8 +124,9 @@ int sweep_stale_temporaries(const std::string& path) {
     for (fs::directory_iterator it(directory, ec), end; !ec && it != end; it.increment(ec)) {
         const pid_t owner = temporary_owner(it->path().filename().string(), name);
         if (owner == 0 || owner == ::getpid()) continue;
-        // Alive (or not ours to signal, EPERM): keep. Only a PID that names no process is stale.
-        if (::kill(owner, 0) == 0 || errno != ESRCH) continue;
+        // Alive (or not ours to signal, EPERM): keep. Only a PID that names no process, or a zombie,
+        // is stale.
+        if ((::kill(owner, 0) == 0 || errno != ESRCH) && !is_zombie(owner)) continue;
         std::error_code remove_ec;
         if (fs::remove(it->path(), remove_ec)) ++removed;
     }

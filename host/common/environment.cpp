@@ -13,12 +13,16 @@ const std::vector<EnvironmentEntry> kEnvironment = {
      "set and not 0: build every kernel afresh (no binary cache read or written)"},
     {kEnvMpiTimeout, "MCRT_MPI_TIMEOUT", "user",
      "seconds an MPI rank may stay silent before it is taken for lost (default 120)"},
+    {kEnvNoSupervisor, "MCRT_NO_SUPERVISOR", "user",
+     "set and not 0: render in this process, without the supervising parent process (debugging)"},
     {kEnvKernelDir, "MCRT_KERNEL_DIR", "development",
      "read the kernel sources from this directory instead of the embedded copies"},
     {kEnvKernelOptions, "MCRT_KERNEL_OPTIONS", "development",
      "extra build options for the render program (the stage profiler's -D switches)"},
     {kEnvBuildChild, "MCRT_BUILD_CHILD", "development",
      "the executable that builds programs in a child process; empty: build in this process"},
+    {kEnvSupervised, "MCRT_SUPERVISED", "internal",
+     "FD,PID: this process is the render of the supervising mcrt PID, reporting on pipe FD"},
     {kEnvTestPause, "MCRT_TEST_PAUSE", "test hook",
      "pause at a named point (before-write, write, exit) so a test can act there"},
     {kEnvTestPauseSeconds, "MCRT_TEST_PAUSE_SECONDS", "test hook",
@@ -55,6 +59,8 @@ std::string environment_value(EnvironmentVariable v) {
     const char* text = environment(v);
     return text ? text : "";
 }
+
+void unset_environment(EnvironmentVariable v) { ::unsetenv(kEnvironment[size_t(v)].name); }
 
 bool environment_device_value(EnvironmentVariable v, int device, double* value) {
     const char* text = environment(v);

@@ -12,10 +12,13 @@ enum EnvironmentVariable {
     kEnvCacheDir,         // MCRT_CACHE_DIR
     kEnvNoKernelCache,    // MCRT_NO_KERNEL_CACHE
     kEnvMpiTimeout,       // MCRT_MPI_TIMEOUT
+    kEnvNoSupervisor,     // MCRT_NO_SUPERVISOR
     // Development overrides.
     kEnvKernelDir,        // MCRT_KERNEL_DIR
     kEnvKernelOptions,    // MCRT_KERNEL_OPTIONS
     kEnvBuildChild,       // MCRT_BUILD_CHILD
+    // Set by mcrt for its own child process.
+    kEnvSupervised,       // MCRT_SUPERVISED
     // Test hooks (common/test_hooks.h).
     kEnvTestPause,        // MCRT_TEST_PAUSE
     kEnvTestPauseSeconds, // MCRT_TEST_PAUSE_SECONDS
@@ -40,7 +43,7 @@ enum EnvironmentVariable {
 struct EnvironmentEntry {
     EnvironmentVariable id;
     const char* name;
-    const char* kind;  // "user", "development", "test hook" or "read"
+    const char* kind;  // "user", "development", "internal", "test hook" or "read"
     const char* description;
 };
 
@@ -52,6 +55,9 @@ const char* environment(EnvironmentVariable v);
 
 // Its value, "" when it is not set.
 std::string environment_value(EnvironmentVariable v);
+
+// Removes the variable from this process's environment (and so from its children's).
+void unset_environment(EnvironmentVariable v);
 
 // "D:V" in the variable: device index D and a value, for test hooks that name one device. True
 // (and *value) when the variable names device `device`.

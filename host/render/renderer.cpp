@@ -161,9 +161,12 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
             if (warn) warn("skipping device " + std::to_string(d->info.index) + " ('" + d->info.name + "'): " + e.what());
         }
     }
+    if (control.launching && !remote) control.launching();
     check_agreement(workers, workers.size(), settings, warn);
-    if (remote)
+    if (remote) {
         for (auto& w : remote()) workers.push_back(std::move(w));
+        if (control.launching) control.launching();
+    }
     if (workers.empty()) throw RuntimeError("no device can render this scene: " + last_error);
     bool any_working = false;
     for (const auto& w : workers) any_working |= !w->report.retired;

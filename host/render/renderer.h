@@ -80,6 +80,9 @@ using ProgressSink =
 struct RenderControl {
     double time_limit = 0;
     const volatile std::sig_atomic_t* interrupted = nullptr;
+    // Called once when the kernels are about to run: after the builds and, in an MPI job, the
+    // other ranks' setup (the supervisor's time limit counts from here, host/cli/supervisor.h).
+    std::function<void()> launching;
 };
 
 struct RenderPlan;  // render/plan.h

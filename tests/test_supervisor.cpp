@@ -1,0 +1,212 @@
+// `mcrt render` in a supervised child (host/cli/supervisor.h): an estimator that never returns
+// is stopped by the time limit or one SIGTERM or SIGINT within the grace period, and one that
+// crashes its process costs one error line and exit 1; nothing is written either way. A render
+// that works exits as it did without the supervisor, with the same image.
+#include <catch2/catch.hpp>
+#include <chrono>
+#include <csignal>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "cli/supervisor.h"
+#include "hostile_support.h"
+#include "image/image.h"
+#include "process_support.h"
+
+using namespace mcrt;
+using namespace mcrt::test;
+
+namespace {
+
+const std::string kCornell = std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf";
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+// An estimator file in `dir` whose estimate() runs `body`.
+std::string estimator_file(const TempDir& dir, const std::string& name, const std::string& body) {
+    const std::string path = dir / name;
+    std::ofstream(path) << "float3 estimate(const SceneView* scene, const SurfacePoint* sp,\n"
+                           "                const SampleStream* stream, uint* rays) {\n"
+                        << body << "\n}\n";
+    return path;
+}
+
+const std::string kHang = "    volatile int forever = 1;\n    while (forever) {}\n    return (float3)(0.0f);";
+
+std::vector<std::string> render_args(const std::string& out, const std::string& estimator,
+                                     std::vector<std::string> extra = {}) {
+    std::vector<std::string> a = {MCRT_EXE, "render", kCornell, "--width", "16", "--height", "16",
+                                  "--spp", "16", "--out", out, "--estimator-file", estimator};
+    a.insert(a.end(), extra.begin(), extra.end());
+    return a;
+}
+
+std::vector<std::string> names_in(const std::filesystem::path& dir) {
+    std::vector<std::string> names;
+    for (const auto& e : std::filesystem::directory_iterator(dir))
+        names.push_back(e.path().filename().string());
+    return names;
+}
+
+// The exit status in a wait status; -1 for a death by a signal.
+int exit_code(int status) { return WIFEXITED(status) ? WEXITSTATUS(status) : -1; }
+
+// The render's end: exit 1, one error line holding `text`, nothing in `out_dir` (no output, no
+// temporary).
+void require_one_error(int code, const std::string& log, const std::string& text,
+                       const TempDir& out_dir) {
+    INFO(log);
+    CHECK(code == 1);
+    const std::vector<std::string> errors = lines_starting_with(log, "mcrt: error:");
+    REQUIRE(errors.size() == 1);
+    CHECK(errors[0].find(text) != std::string::npos);
+    CHECK(names_in(out_dir.path()).empty());
+}
+
+// The state letter of process `pid` (proc(5): R, S, T stopped, Z ...).
+char process_state(pid_t pid) {
+    const std::string stat = read_whole_file("/proc/" + std::to_string(pid) + "/stat");
+    const size_t paren = stat.rfind(')');
+    return paren != std::string::npos && paren + 2 < stat.size() ? stat[paren + 2] : '?';
+}
+
+// Waits until process `pid` is in (or, with `in` false, out of) state `state`; false after
+// `seconds`.
+bool wait_for_state(pid_t pid, char state, bool in, double seconds) {
+    const auto start = Clock::now();
+    while (seconds_since(start) < seconds) {
+        if ((process_state(pid) == state) == in) return true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return false;
+}
+
+}  // namespace
+
+TEST_CASE("a hanging estimator is stopped by the time limit within the grace period",
+          "[supervisor][signals][cli]") {
+    TempDir src("mcrt-sup-src"), out("mcrt-sup-out"), logs("mcrt-sup-logs");
+    const std::string hang = estimator_file(src, "hang.cl", kHang);
+    Child child(render_args(out / "a.exr", hang, {"--time-limit", "1"}), {}, logs / "log");
+    // The progress bar's first line: the kernels are built and launched.
+    REQUIRE(child.wait_for_text(" spp ", 120));
+    const auto launched = Clock::now();
+    const int status = child.wait(60);
+    REQUIRE_FALSE(child.timed_out());
+    CHECK(seconds_since(launched) < 1 + kSupervisorGraceSeconds + 3);
+    require_one_error(exit_code(status), child.output(),
+                      "the time limit of 1 s passed, but a launch on the devices did not return "
+                      "within 5 s of it with the estimator file " + hang,
+                      out);
+}
+
+TEST_CASE("a hanging estimator is stopped by one SIGTERM or one SIGINT within the grace period",
+          "[supervisor][signals][cli]") {
+    for (int sig : {SIGTERM, SIGINT}) {
+        DYNAMIC_SECTION((sig == SIGTERM ? "SIGTERM" : "SIGINT")) {
+            TempDir src("mcrt-sup-src"), out("mcrt-sup-out"), logs("mcrt-sup-logs");
+            const std::string hang = estimator_file(src, "hang.cl", kHang);
+            Child child(render_args(out / "a.exr", hang), {}, logs / "log");
+            REQUIRE(child.wait_for_text(" spp ", 120));
+            child.signal(sig);
+            const auto signalled = Clock::now();
+            const int status = child.wait(60);
+            REQUIRE_FALSE(child.timed_out());
+            CHECK(seconds_since(signalled) < kSupervisorGraceSeconds + 3);
+            require_one_error(exit_code(status), child.output(),
+                              std::string("stopped by ") + (sig == SIGTERM ? "SIGTERM" : "SIGINT") +
+                                  ", but a launch on the devices did not return within 5 s",
+                              out);
+        }
+    }
+}
+
+TEST_CASE("an estimator that crashes its process costs one error line naming the signal",
+          "[supervisor][cli]") {
+    const std::pair<const char*, const char*> crashes[] = {
+        {"a wild global pointer", "    *(global volatile int*)(0x10) = 1;\n    return (float3)(0.0f);"},
+        {"a private index far out of bounds",
+         "    volatile float a[4];\n    volatile int i = 100000000;\n    a[i] = 1.0f;\n"
+         "    return (float3)(a[0]);"}};
+    for (const auto& [what, body] : crashes) {
+        DYNAMIC_SECTION(what) {
+            TempDir src("mcrt-sup-src"), out("mcrt-sup-out"), logs("mcrt-sup-logs");
+            const std::string file = estimator_file(src, "crash.cl", body);
+            std::vector<std::string> args = render_args(out / "a.exr", file, {"--quiet"});
+            args.erase(args.begin());
+            const ProcessResult r = run_process(MCRT_EXE, args, logs.path(), 120);
+            REQUIRE_FALSE(r.timed_out);
+            require_one_error(r.exit_code, r.err,
+                              "the render died of signal 11 (SIGSEGV, Segmentation fault) while "
+                              "the devices ran the kernels with the estimator file " + file,
+                              out);
+        }
+    }
+}
+
+TEST_CASE("a render killed from outside with SIGKILL is one error line",
+          "[supervisor][signals][cli]") {
+    TempDir src("mcrt-sup-src"), out("mcrt-sup-out"), logs("mcrt-sup-logs");
+    const std::string hang = estimator_file(src, "hang.cl", kHang);
+    Child child(render_args(out / "a.exr", hang), {}, logs / "log");
+    REQUIRE(child.wait_for_text(" spp ", 120));
+    REQUIRE(child.render_pid() != child.pid());
+    ::kill(child.render_pid(), SIGKILL);  // as the kernel's out-of-memory killer does
+    const int status = child.wait(30);
+    require_one_error(exit_code(status), child.output(), "the render was killed (SIGKILL: out of memory?)",
+                      out);
+}
+
+TEST_CASE("Ctrl-Z stops the render with its supervisor and fg continues both",
+          "[supervisor][signals][cli]") {
+    // The render is in a process group of its own, so a terminal's SIGTSTP reaches only the
+    // supervisor, which stops it too; SIGCONT goes on with both.
+    TempDir src("mcrt-sup-src"), out("mcrt-sup-out"), logs("mcrt-sup-logs");
+    const std::string hang = estimator_file(src, "hang.cl", kHang);
+    Child child(render_args(out / "a.exr", hang), {}, logs / "log");
+    REQUIRE(child.wait_for_text(" spp ", 120));
+    const pid_t render = child.render_pid();
+    REQUIRE(render != child.pid());
+    child.signal(SIGTSTP);
+    CHECK(wait_for_state(child.pid(), 'T', true, 10));
+    CHECK(wait_for_state(render, 'T', true, 10));
+    child.signal(SIGCONT);
+    CHECK(wait_for_state(child.pid(), 'T', false, 10));
+    CHECK(wait_for_state(render, 'T', false, 10));
+    child.signal(SIGTERM);  // and it still stops
+    const int status = child.wait(60);
+    require_one_error(exit_code(status), child.output(), "stopped by SIGTERM", out);
+}
+
+TEST_CASE("a render that works exits as without the supervisor, with the same image",
+          "[supervisor][cli]") {
+    TempDir dir("mcrt-sup"), logs("mcrt-sup-logs");
+    auto args = [&](const std::string& out) {
+        return std::vector<std::string>{"render", kCornell, "--width", "32", "--height", "24",
+                                        "--spp", "32", "--quiet", "--out", out};
+    };
+    const ProcessResult supervised = run_process(MCRT_EXE, args(dir / "a.exr"), logs.path(), 120);
+    setenv("MCRT_NO_SUPERVISOR", "1", 1);
+    const ProcessResult alone = run_process(MCRT_EXE, args(dir / "b.exr"), logs.path(), 120);
+    // Bad input: exit 2 and the one line, with or without.
+    const ProcessResult bad_alone =
+        run_process(MCRT_EXE, args(dir / "missing/c.exr"), logs.path(), 60);
+    unsetenv("MCRT_NO_SUPERVISOR");
+    const ProcessResult bad = run_process(MCRT_EXE, args(dir / "missing/c.exr"), logs.path(), 60);
+    INFO(supervised.err << alone.err);
+    CHECK(supervised.exit_code == 0);
+    CHECK(alone.exit_code == 0);
+    CHECK(supervised.err == alone.err);
+    const Image a = read_exr(dir / "a.exr"), b = read_exr(dir / "b.exr");
+    REQUIRE(a.rgb.size() == b.rgb.size());
+    CHECK(std::memcmp(a.rgb.data(), b.rgb.data(), a.rgb.size() * sizeof(float)) == 0);
+    CHECK(bad.exit_code == 2);
+    CHECK(bad.err == bad_alone.err);
+    CHECK(lines_starting_with(bad.err, "mcrt: error:").size() == 1);
+}
