@@ -144,3 +144,62 @@ TEST_CASE("a uri with a scheme other than data: is refused naming it", "[gltf][h
     CHECK(refusal(dir / "image.gltf").find("image 0: uri 'https://x/t.png': the https scheme") !=
           std::string::npos);
 }
+
+// ---- what ran out, named: memory limits and PoCL's environment ------------------------------
+
+namespace {
+
+// `mcrt ARGS` through /bin/sh with `prefix` before it ("ulimit -v N;", "POCL_DEVICES=x").
+ProcessResult run_mcrt_shell(const TempDir& dir, const std::string& prefix, const std::string& args) {
+    return run_process("/bin/sh", {"-c", prefix + " exec '" + MCRT_EXE + "' " + args}, dir.path(), 60);
+}
+
+}  // namespace
+
+TEST_CASE("out of host memory while loading a scene is a runtime failure naming it",
+          "[gltf][hostile][cli]") {
+    TempDir dir("mcrt-resources");
+    write_file(dir / "a.bin", triangle_bytes(120));
+    fs::resize_file(dir / "a.bin", 1ull << 30);
+    write_file(dir / "huge.gltf", scene_text("a.bin", size_t(1) << 30));
+    // 400 MiB of address space: mcrt starts, a 1 GiB buffer cannot be had (it was "std::bad_alloc"
+    // as an input error, exit 2).
+    const ProcessResult r = run_mcrt_shell(
+        dir, "ulimit -v 409600;", "render '" + dir / "huge.gltf" + "' --quiet --out '" + dir / "a.exr" + "'");
+    INFO(r.err);
+    CHECK(r.exit_code == 1);
+    CHECK(r.err == "mcrt: error: out of host memory while loading the scene\n");
+}
+
+TEST_CASE("no device found says why: POCL_DEVICES, a memory limit", "[cli][hostile]") {
+    TempDir dir("mcrt-resources");
+    ProcessResult r = run_mcrt_shell(dir, "POCL_DEVICES=nonsense", "devices");
+    CHECK(r.exit_code == 1);
+    CHECK(r.err.rfind("mcrt: error: no OpenCL device found: POCL_DEVICES='nonsense' names no device "
+                      "type PoCL has (nonsense); it accepts a space-separated list of ",
+                      0) == 0);
+    CHECK(r.err.find("pthread") != std::string::npos);
+    CHECK(lines_starting_with(r.err, "mcrt:").size() == 1);
+    // 150 MiB: mcrt starts, PoCL's LLVM cannot be mapped.
+    r = run_mcrt_shell(dir, "ulimit -v 153600;", "devices");
+    INFO(r.err);
+    CHECK(r.exit_code == 1);
+    CHECK(r.err.find("cannot be loaded: ") != std::string::npos);
+    CHECK(r.err.find("the address-space limit (ulimit -v) is 150 MiB\n") != std::string::npos);
+    CHECK(lines_starting_with(r.err, "mcrt:").size() == 1);
+}
+
+TEST_CASE("POCL_CACHE_DIR naming a file fails the kernel build naming it", "[cli][hostile]") {
+    TempDir dir("mcrt-resources");
+    write_file(dir / "file", std::string("x"));
+    const ProcessResult r = run_mcrt_shell(
+        dir, "POCL_CACHE_DIR='" + dir / "file" + "'",
+        "render '" MCRT_SCENES "/cornell/CornellBox-Original.gltf' --width 8 --height 8 --quiet --out '" +
+            dir / "a.exr" + "'");
+    CHECK(r.exit_code == 1);
+    CHECK(r.err.find("kernel build failed on '") == 13);
+    CHECK(r.err.find("': PoCL's kernel cache directory " + dir / "file" + " cannot be created (" +
+                     dir / "file" + " is not a directory); set POCL_CACHE_DIR to a writable directory\n") !=
+          std::string::npos);
+    CHECK(lines_starting_with(r.err, "mcrt:").size() == 1);
+}

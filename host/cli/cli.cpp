@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <iostream>
+#include <system_error>
 
 #include "bench/bench.h"
 #include "cl/device.h"
@@ -13,12 +14,19 @@
 #include "cli/render_command.h"
 #include "cli/usage_errors.h"
 #include "cli/validators.h"
+#include "common/activity.h"
 #include "common/error.h"
 #include "mpi/job.h"
 #include "render/variants.h"
 
 namespace mcrt {
 namespace {
+
+// "out of host memory while building the BVH": what ran out and what mcrt was doing.
+std::string resource_message(const std::string& what) {
+    const std::string activity = current_activity();
+    return activity.empty() ? what : what + " while " + activity;
+}
 
 int run_devices() {
     std::vector<DeviceInfo> devices = enumerate_devices(print_warning);
@@ -122,7 +130,16 @@ int run_cli(int argc, char** argv) {
         std::cerr << "mcrt: error: " << e.what() << std::endl;
         return 1;
     } catch (const std::bad_alloc&) {
-        std::cerr << "\nmcrt: error: out of host memory" << std::endl;
+        std::cerr << "mcrt: error: " << resource_message("out of host memory") << std::endl;
+        return 1;
+    } catch (const std::system_error& e) {
+        // std::thread's EAGAIN: no thread to be had (RLIMIT_NPROC, or memory for its stack).
+        std::cerr << "mcrt: error: "
+                  << (e.code() == std::errc::resource_unavailable_try_again
+                          ? resource_message("cannot start a thread (" + e.code().message() +
+                                             ": a process or memory limit)")
+                          : std::string(e.what()))
+                  << std::endl;
         return 1;
     } catch (const std::exception& e) {
         std::cerr << "mcrt: error: " << e.what() << std::endl;

@@ -1,5 +1,7 @@
 #include "render/plan.h"
 
+#include "common/activity.h"
+
 #include <chrono>
 
 #include "common/error.h"
@@ -102,15 +104,24 @@ PlannedRender plan_render(const RenderRequest& request, const SceneSource& sourc
     const RenderVariants& v = r.plan.variants;
     const RenderSettings& s = r.plan.settings;
     const auto load_start = std::chrono::steady_clock::now();
-    r.scene.scene = read_scene(request.scene, source, warn);
+    {
+        const Activity activity("loading the scene");
+        r.scene.scene = read_scene(request.scene, source, warn);
+    }
     r.scene.seconds_load =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
     Scene& scene = r.scene.scene;
     if (v.materials->lambertian) make_lambertian(scene.materials);
     r.scene.camera = choose_camera(scene, request.camera);
-    r.scene.bvh = build_bvh(scene);
-    r.scene.gpu = make_gpu_scene(scene, r.scene.bvh, r.scene.camera, s.width, s.height,
-                                 v.light_select->id);
+    {
+        const Activity activity("building the BVH");
+        r.scene.bvh = build_bvh(scene);
+    }
+    {
+        const Activity activity("laying out the scene for the devices");
+        r.scene.gpu = make_gpu_scene(scene, r.scene.bvh, r.scene.camera, s.width, s.height,
+                                     v.light_select->id);
+    }
     if (warn && scene.triangle_count() == 0) warn(request.scene + ": the scene has no triangles");
     if (warn && v.uses(kUsesLights) && !s.sky_light && r.scene.gpu.lights.empty())
         warn(request.scene + ": no emissive triangles: direct lighting is black" +

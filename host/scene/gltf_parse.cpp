@@ -203,6 +203,8 @@ tinygltf::Model parse_gltf(const std::string& name, const std::vector<unsigned c
                     : loader.LoadASCIIFromString(&model, &error, &warning,
                                                  reinterpret_cast<const char*>(bytes.data()),
                                                  length, base_dir);
+    } catch (const std::bad_alloc&) {
+        throw;  // not the file's fault: out of host memory (run_cli names it)
     } catch (const std::exception& e) {
         throw InputError(name + ": " + e.what());
     }
