@@ -203,3 +203,18 @@ TEST_CASE("POCL_CACHE_DIR naming a file fails the kernel build naming it", "[cli
           std::string::npos);
     CHECK(lines_starting_with(r.err, "mcrt:").size() == 1);
 }
+
+TEST_CASE("variants, devices and bench fail when stdout is full or closed", "[cli][hostile]") {
+    TempDir dir("mcrt-resources");
+    const std::string bench =
+        "bench '" MCRT_SCENES "/cornell/CornellBox-Original.gltf' --width 8 --height 8 --repeats 1 --rays primary";
+    for (const std::string command : {"variants --json", "variants", "devices", bench.c_str()}) {
+        INFO(command);
+        ProcessResult r = run_mcrt_shell(dir, "", command + " >/dev/full");
+        CHECK(r.exit_code == 1);
+        CHECK(r.err == "mcrt: error: cannot write to stdout: No space left on device\n");
+        r = run_mcrt_shell(dir, "", command + " >&-");
+        CHECK(r.exit_code == 1);
+        CHECK(r.err == "mcrt: error: cannot write to stdout: it is closed\n");
+    }
+}
