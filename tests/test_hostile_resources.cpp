@@ -218,3 +218,18 @@ TEST_CASE("variants, devices and bench fail when stdout is full or closed", "[cl
         CHECK(r.err == "mcrt: error: cannot write to stdout: it is closed\n");
     }
 }
+
+TEST_CASE("a triangle strip or fan of fewer than 3 is refused like TRIANGLES of 5", "[gltf][hostile]") {
+    TempDir dir("mcrt-resources");
+    write_file(dir / "a.bin", triangle_bytes(120));
+    for (const int mode : {5, 6}) {
+        std::string text = scene_text("a.bin");
+        // Two of the three indices, as a strip (5) or a fan (6).
+        text.replace(text.find(R"("count": 3, "type": "SCALAR")"), 28, R"("count": 2, "type": "SCALAR")");
+        text.replace(text.find(R"("indices": 1)"), 12, R"("indices": 1, "mode": )" + std::to_string(mode));
+        write_file(dir / "strip.gltf", text);
+        CHECK(refusal(dir / "strip.gltf") ==
+              dir / "strip.gltf" + ": mesh 0 primitive 0: 2 indices are fewer than one triangle's 3 (mode " +
+                  (mode == 5 ? "TRIANGLE_STRIP" : "TRIANGLE_FAN") + ")");
+    }
+}
