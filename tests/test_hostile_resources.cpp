@@ -233,3 +233,25 @@ TEST_CASE("a triangle strip or fan of fewer than 3 is refused like TRIANGLES of 
                   (mode == 5 ? "TRIANGLE_STRIP" : "TRIANGLE_FAN") + ")");
     }
 }
+
+TEST_CASE("experiment and bench scripts refuse an --out naming a file in argparse's style",
+          "[scripts][hostile]") {
+    TempDir dir("mcrt-resources");
+    write_file(dir / "file", std::string("x"));
+    for (const char* script :
+         {"experiments/experiment.py", "experiments/light_select_table.py", "experiments/path_depths.py",
+          "experiments/pixel_maps.py", "experiments/veach_mis.py", "experiments/textured_gallery.py",
+          "experiments/textured_mitsuba.py", "bench/bench_paths.py", "bench/bench_vs_mitsuba.py"}) {
+        INFO(script);
+        const std::string name = fs::path(script).filename().string();
+        const ProcessResult r = run_process(
+            "/usr/bin/python3",
+            {std::string(MCRT_SOURCE_DIR) + "/scripts/" + script, MCRT_SCENES "/cornell/CornellBox-Original.gltf",
+             "--estimators", "light-area", "--out", dir / "file"},
+            dir.path(), 60);
+        CHECK(r.exit_code == 2);
+        CHECK(r.err.find("Traceback") == std::string::npos);
+        CHECK(r.err.find(name + ": error: argument --out: " + dir / "file" +
+                         " is a file, not a directory\n") != std::string::npos);
+    }
+}
