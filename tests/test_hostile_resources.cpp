@@ -8,6 +8,7 @@
 
 #include "common/error.h"
 #include "process_support.h"
+#include "render/plan.h"
 #include "scene/gltf_import.h"
 #include "scene/gltf_uris.h"
 
@@ -254,4 +255,41 @@ TEST_CASE("experiment and bench scripts refuse an --out naming a file in argpars
         CHECK(r.err.find(name + ": error: argument --out: " + dir / "file" +
                          " is a file, not a directory\n") != std::string::npos);
     }
+}
+
+TEST_CASE("--camera K names glTF camera K, an orthographic one refused", "[gltf][cli]") {
+    TempDir dir("mcrt-resources");
+    write_file(dir / "a.bin", triangle_bytes(120));
+    std::string text = scene_text("a.bin");
+    // cameras: 0 orthographic, 1 and 2 perspective, 3 on no node; nodes list camera 2 first.
+    text.replace(text.find(R"("nodes": [{"mesh": 0}])"), 22,
+                 R"("cameras": [{"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "zfar": 10, "znear": 0.1}},
+                {"name": "one", "type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}},
+                {"name": "two", "type": "perspective", "perspective": {"yfov": 0.6, "znear": 0.1}},
+                {"name": "three", "type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1}}],
+  "nodes": [{"mesh": 0}, {"camera": 2, "translation": [0, 1, 3]}, {"camera": 0}, {"camera": 1, "translation": [0, 1, 4]}])");
+    text.replace(text.find(R"("scenes": [{"nodes": [0]}])"), 26, R"("scenes": [{"nodes": [0, 1, 2, 3]}])");
+    write_file(dir / "cameras.gltf", text);
+    const Scene scene = load_gltf(dir / "cameras.gltf", [](const std::string&) {});
+    auto chosen = [&](int k) {
+        CameraChoice choice;
+        choice.index = k;
+        return choose_camera(scene, choice);
+    };
+    auto refusal_of = [&](int k) {
+        try {
+            chosen(k);
+        } catch (const InputError& e) {
+            return std::string(e.what());
+        }
+        return std::string("(chosen)");
+    };
+    CHECK(choose_camera(scene, CameraChoice{}).name == "two");  // the first camera node
+    CHECK(chosen(1).name == "one");  // it was "two": the second perspective node counted
+    CHECK(chosen(2).name == "two");
+    CHECK(refusal_of(0).find("camera 0 of " + dir / "cameras.gltf" +
+                             " is orthographic; only perspective cameras are rendered") != std::string::npos);
+    CHECK(refusal_of(3).find("camera 3 of " + dir / "cameras.gltf" + " is on no node of the default scene") !=
+          std::string::npos);
+    CHECK(refusal_of(4).find(dir / "cameras.gltf" + " has 4 cameras (0 to 3)") != std::string::npos);
 }

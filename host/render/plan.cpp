@@ -83,11 +83,21 @@ RenderPlan make_render_plan(const RenderSettings& settings, const GpuSceneData& 
 Camera choose_camera(const Scene& scene, const CameraChoice& choice) {
     if (choice.look) return *choice.look;
     if (choice.index >= 0) {
-        if (size_t(choice.index) >= scene.cameras.size())
-            throw SettingError("camera", std::to_string(choice.index) + ": " + scene.path +
-                                             " has " + std::to_string(scene.cameras.size()) +
-                                             " perspective camera(s)");
-        return scene.cameras[size_t(choice.index)];
+        // K names glTF `cameras[K]`, seen from its first node in default-scene traversal order.
+        const size_t count = scene.gltf_camera_types.size();
+        const std::string k = std::to_string(choice.index);
+        if (size_t(choice.index) >= count)
+            throw SettingError("camera", k + ": " + scene.path + " has " + std::to_string(count) +
+                                             (count == 1 ? " camera" : " cameras") +
+                                             (count ? " (0 to " + std::to_string(count - 1) + ")" : ""));
+        const std::string& type = scene.gltf_camera_types[size_t(choice.index)];
+        if (type != "perspective")
+            throw SettingError("camera", k + ": camera " + k + " of " + scene.path + " is " +
+                                             type + "; only perspective cameras are rendered");
+        for (const Camera& camera : scene.cameras)
+            if (camera.gltf_index == choice.index) return camera;
+        throw SettingError("camera", k + ": camera " + k + " of " + scene.path +
+                                         " is on no node of the default scene");
     }
     return scene.cameras.empty() ? bench_camera(scene) : scene.cameras.front();
 }
