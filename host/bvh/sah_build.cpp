@@ -6,8 +6,10 @@
 #include <chrono>
 #include <cstdint>
 #include <cstring>
+#include <exception>
 #include <limits>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -396,23 +398,39 @@ std::vector<gpu::BvhNode> Builder::build_parallel(const Task& root, const gpu::B
     });
     std::atomic<size_t> next{0};
     std::vector<int> depths(threads, 0);
+    // A failure (out of memory) in any thread stops the others at their next subtree and is
+    // rethrown once every thread has been joined.
+    std::vector<std::exception_ptr> failures(threads);
     auto work = [&](unsigned thread) {
-        Scratch scratch(bins_);
-        for (size_t i; (i = next.fetch_add(1)) < order.size();) {
-            const size_t d = order[i];
-            std::vector<gpu::BvhNode>& nodes = subtrees[d];
-            Task task = deferred[d];
-            nodes.reserve(2 * size_t(task.end - task.begin) - 1);
-            nodes.push_back(top[task.node]);
-            task.node = 0;
-            build_subtree(task, nodes, scratch, 0, nullptr);
+        try {
+            Scratch scratch(bins_);
+            for (size_t i; (i = next.fetch_add(1)) < order.size();) {
+                const size_t d = order[i];
+                std::vector<gpu::BvhNode>& nodes = subtrees[d];
+                Task task = deferred[d];
+                nodes.reserve(2 * size_t(task.end - task.begin) - 1);
+                nodes.push_back(top[task.node]);
+                task.node = 0;
+                build_subtree(task, nodes, scratch, 0, nullptr);
+            }
+            depths[thread] = scratch.depth;
+        } catch (...) {
+            failures[thread] = std::current_exception();
+            next = order.size();
         }
-        depths[thread] = scratch.depth;
     };
     std::vector<std::thread> pool;
-    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work, t);
+    for (unsigned t = 1; t < threads; ++t) {
+        try {
+            pool.emplace_back(work, t);
+        } catch (const std::system_error&) {
+            break;  // no more threads to be had: those running share the rest
+        }
+    }
     work(0);
     for (std::thread& t : pool) t.join();
+    for (const std::exception_ptr& failure : failures)
+        if (failure) std::rethrow_exception(failure);
     for (int d : depths) depth = std::max(depth, d);
 
     // Splice: walk the top depth-first, giving each node's children the next pair of slots.

@@ -1,5 +1,7 @@
 #include "cl/device_select.h"
 
+#include "common/activity.h"
+
 #include <algorithm>
 #include <cctype>
 #include <set>
@@ -36,6 +38,7 @@ static bool numeric(const std::string& spec) {
 
 std::vector<DeviceInfo> select_devices(const std::vector<std::string>& specs,
                                        const std::function<void(const std::string&)>& warn) {
+    const Activity activity("setting up the OpenCL devices");
     std::vector<DeviceInfo> all = enumerate_devices(warn);
     if (all.empty()) throw RuntimeError(no_device_message());
     if (specs.empty()) return {all.front()};

@@ -1,14 +1,20 @@
-// Why no OpenCL device was found, when the cause is known: PoCL finds no device at all when it
-// cannot create its kernel cache directory, which is not "no ICD installed".
+// Why no OpenCL device was found, or a kernel build failed without a log, when the cause is known
+// from the environment rather than "no ICD installed".
 #pragma once
 
 #include <string>
 
 namespace mcrt {
 
-// "no OpenCL device found: PoCL's kernel cache directory /x/pocl cannot be created (Not a
-// directory); set POCL_CACHE_DIR to a writable directory", or the plain message when the cache
-// directory is usable.
+// Why no device was found, where mcrt can tell: "no OpenCL device found: " and POCL_DEVICES
+// naming no device type PoCL has (listing those it has), an unusable PoCL cache directory, or an
+// installed implementation that cannot be loaded (dlopen's reason, with the address-space limit);
+// else the plain message.
 std::string no_device_message();
+
+// "PoCL's kernel cache directory /x/pocl cannot be created (/x is not a directory); set
+// POCL_CACHE_DIR to a writable directory", or "" when it is usable. PoCL then finds no device,
+// or, with a device already set up, fails every kernel build without a log.
+std::string pocl_cache_problem();
 
 }  // namespace mcrt

@@ -13,6 +13,7 @@
 #include "cl/binary_cache.h"
 #include "cl/build_child.h"
 #include "cl/cl_error.h"
+#include "cl/no_device.h"
 
 namespace mcrt {
 
@@ -98,6 +99,12 @@ cl::Program build_program(const cl::Context& context, const cl::Device& device,
         std::string log, name;
         program.getBuildInfo(device, CL_PROGRAM_BUILD_LOG, &log);
         device.getInfo(CL_DEVICE_NAME, &name);
+        // PoCL with an unusable cache directory fails every build and logs no reason.
+        std::string platform;
+        cl::Platform(device.getInfo<CL_DEVICE_PLATFORM>()).getInfo(CL_PLATFORM_NAME, &platform);
+        const std::string cache = pocl_cache_problem();
+        if (!cache.empty() && platform.find("Portable Computing Language") != std::string::npos)
+            throw RuntimeError("kernel build failed on '" + name + "': " + cache);
         throw RuntimeError("kernel build failed on '" + name + "' (" + cl_error_name(status) +
                            ", options '" + options + "'):\n" + log);
     }

@@ -1,8 +1,14 @@
 #include "cli/cli.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
+#include <cerrno>
+#include <cstring>
 #include <cstdio>
 #include <iostream>
+#include <system_error>
 
 #include "bench/bench.h"
 #include "cl/device.h"
@@ -13,12 +19,44 @@
 #include "cli/render_command.h"
 #include "cli/usage_errors.h"
 #include "cli/validators.h"
+#include "common/activity.h"
 #include "common/error.h"
 #include "mpi/job.h"
 #include "render/variants.h"
 
 namespace mcrt {
 namespace {
+
+// Whether descriptor 1 was closed (`mcrt devices >&-`); if so /dev/null holds it, so that no file
+// opened later (a cache, a library) becomes stdout and receives what is printed.
+bool hold_closed_stdout() {
+    if (::fcntl(STDOUT_FILENO, F_GETFD) != -1 || errno != EBADF) return false;
+    const int fd = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (fd >= 0 && fd != STDOUT_FILENO) {
+        ::dup2(fd, STDOUT_FILENO);
+        ::close(fd);
+    }
+    return true;
+}
+
+// `status`, once everything printed has reached stdout; a write that failed there (ENOSPC on
+// /dev/full, EPIPE, EIO: write(2)) is a runtime failure, as a lost result must not exit 0. The
+// reason is errno of the write that failed (stdio keeps only the error flag): clear errno before
+// printing.
+int finish_stdout(int status) {
+    std::cout.flush();
+    const bool ok = std::cout.good() && std::fflush(stdout) == 0 && !std::ferror(stdout);
+    if (!ok)
+        throw RuntimeError(std::string("cannot write to stdout: ") +
+                           std::strerror(errno ? errno : EIO));
+    return status;
+}
+
+// "out of host memory while building the BVH": what ran out and what mcrt was doing.
+std::string resource_message(const std::string& what) {
+    const std::string activity = current_activity();
+    return activity.empty() ? what : what + " while " + activity;
+}
 
 int run_devices() {
     std::vector<DeviceInfo> devices = enumerate_devices(print_warning);
@@ -74,6 +112,7 @@ CLI::App* add_bench_command(CLI::App& app, BenchOptions& o, CameraOptions& look)
 }  // namespace
 
 int run_cli(int argc, char** argv) {
+    const bool stdout_closed = hold_closed_stdout();
     CLI::App app{"mcrt — an OpenCL Monte Carlo renderer for light-transport estimator experiments"};
     app.require_subcommand(1);
 
@@ -104,16 +143,22 @@ int run_cli(int argc, char** argv) {
     }
 
     try {
-        if (app.got_subcommand("devices")) return run_devices();
+        // What prints its result on stdout fails when it cannot (integrate checks its own).
+        const bool prints = app.got_subcommand("devices") || app.got_subcommand("variants") ||
+                            app.got_subcommand("bench");
+        if (prints && stdout_closed) throw RuntimeError("cannot write to stdout: it is closed");
+        errno = 0;
+        if (app.got_subcommand("devices")) return finish_stdout(run_devices());
         if (app.got_subcommand("variants")) {
+            errno = 0;
             std::cout << (variants_as_json ? variants_json() : variants_text());
-            return 0;
+            return finish_stdout(0);
         }
         if (app.got_subcommand("render")) return run_render(render_options);
         if (app.got_subcommand("integrate")) return run_integrate(integrate_options);
         if (app.got_subcommand("bench")) {
             bench_options.camera = look_at_camera(bench_look);
-            return run_bench(bench_options, print_warning);
+            return finish_stdout(run_bench(bench_options, print_warning));
         }
     } catch (const InputError& e) {
         std::cerr << "mcrt: error: " << e.what() << std::endl;
@@ -122,7 +167,16 @@ int run_cli(int argc, char** argv) {
         std::cerr << "mcrt: error: " << e.what() << std::endl;
         return 1;
     } catch (const std::bad_alloc&) {
-        std::cerr << "\nmcrt: error: out of host memory" << std::endl;
+        std::cerr << "mcrt: error: " << resource_message("out of host memory") << std::endl;
+        return 1;
+    } catch (const std::system_error& e) {
+        // std::thread's EAGAIN: no thread to be had (RLIMIT_NPROC, or memory for its stack).
+        std::cerr << "mcrt: error: "
+                  << (e.code() == std::errc::resource_unavailable_try_again
+                          ? resource_message("cannot start a thread (" + e.code().message() +
+                                             ": a process or memory limit)")
+                          : std::string(e.what()))
+                  << std::endl;
         return 1;
     } catch (const std::exception& e) {
         std::cerr << "mcrt: error: " << e.what() << std::endl;

@@ -182,7 +182,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
         ->capture_default_str()
         ->check(kFinite)
         ->check(CLI::Range(0.0f, 3.4e38f));
-    CLI::Option* camera = cmd->add_option("--camera", o.camera, "camera index in the scene")
+    CLI::Option* camera = cmd->add_option("--camera", o.camera, "glTF camera index in the scene (cameras[K])")
                               ->check(CLI::Range(0, 1 << 30));
     add_camera_options(cmd, o.look, camera);
     cmd->add_option("--device", o.devices, "device index, cpu, gpu, all or a platform such as pocl or intel (repeatable)");

@@ -31,6 +31,8 @@ enum EnvironmentVariable {
     // Set by others, read by mcrt.
     kEnvPoclKernelCache,  // POCL_KERNEL_CACHE
     kEnvPoclCacheDir,     // POCL_CACHE_DIR
+    kEnvPoclDevices,      // POCL_DEVICES
+    kEnvOclIcdVendors,    // OCL_ICD_VENDORS
     kEnvXdgCacheHome,     // XDG_CACHE_HOME
     kEnvHome,             // HOME
     kEnvOmpiWorldSize,    // OMPI_COMM_WORLD_SIZE

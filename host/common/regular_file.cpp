@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -36,7 +37,7 @@ std::string why_not_regular_file(const std::string& path) {
 }
 
 bool read_regular_file(const std::string& path, std::vector<unsigned char>& out, std::string& why,
-                       size_t max_bytes) {
+                       const FileSizeLimits& limits) {
     why = why_not_regular_file(path);
     if (!why.empty()) return false;
     const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
@@ -46,17 +47,23 @@ bool read_regular_file(const std::string& path, std::vector<unsigned char>& out,
     }
     struct stat st {};
     bool ok = ::fstat(fd, &st) == 0;
+    const uint64_t size = ok ? static_cast<uint64_t>(st.st_size) : 0;
     if (!ok) {
         why = std::strerror(errno);
     } else if (!S_ISREG(st.st_mode)) {
         why = refusal(st.st_mode);
         ok = false;
-    } else if (static_cast<unsigned long long>(st.st_size) > max_bytes) {
-        why = "larger than " + std::to_string(max_bytes >> 20) + " MiB";
+    } else if (size > limits.max_bytes) {
+        why = "holds " + std::to_string(size) + " bytes, more than the " +
+              std::to_string(limits.max_bytes) + " allowed";
+        ok = false;
+    } else if (size < limits.min_bytes) {
+        why = "holds " + std::to_string(size) + " bytes, fewer than the " +
+              std::to_string(limits.min_bytes) + " declared";
         ok = false;
     }
     if (ok) {
-        out.resize(static_cast<size_t>(st.st_size));
+        out.resize(static_cast<size_t>(std::min(size, limits.read_bytes)));
         size_t done = 0;
         while (done < out.size()) {
             const ssize_t n = ::read(fd, out.data() + done, out.size() - done);

@@ -1,5 +1,7 @@
 #include "render/plan.h"
 
+#include "common/activity.h"
+
 #include <chrono>
 
 #include "common/error.h"
@@ -81,11 +83,21 @@ RenderPlan make_render_plan(const RenderSettings& settings, const GpuSceneData& 
 Camera choose_camera(const Scene& scene, const CameraChoice& choice) {
     if (choice.look) return *choice.look;
     if (choice.index >= 0) {
-        if (size_t(choice.index) >= scene.cameras.size())
-            throw SettingError("camera", std::to_string(choice.index) + ": " + scene.path +
-                                             " has " + std::to_string(scene.cameras.size()) +
-                                             " perspective camera(s)");
-        return scene.cameras[size_t(choice.index)];
+        // K names glTF `cameras[K]`, seen from its first node in default-scene traversal order.
+        const size_t count = scene.gltf_camera_types.size();
+        const std::string k = std::to_string(choice.index);
+        if (size_t(choice.index) >= count)
+            throw SettingError("camera", k + ": " + scene.path + " has " + std::to_string(count) +
+                                             (count == 1 ? " camera" : " cameras") +
+                                             (count ? " (0 to " + std::to_string(count - 1) + ")" : ""));
+        const std::string& type = scene.gltf_camera_types[size_t(choice.index)];
+        if (type != "perspective")
+            throw SettingError("camera", k + ": camera " + k + " of " + scene.path + " is " +
+                                             type + "; only perspective cameras are rendered");
+        for (const Camera& camera : scene.cameras)
+            if (camera.gltf_index == choice.index) return camera;
+        throw SettingError("camera", k + ": camera " + k + " of " + scene.path +
+                                         " is on no node of the default scene");
     }
     return scene.cameras.empty() ? bench_camera(scene) : scene.cameras.front();
 }
@@ -102,15 +114,24 @@ PlannedRender plan_render(const RenderRequest& request, const SceneSource& sourc
     const RenderVariants& v = r.plan.variants;
     const RenderSettings& s = r.plan.settings;
     const auto load_start = std::chrono::steady_clock::now();
-    r.scene.scene = read_scene(request.scene, source, warn);
+    {
+        const Activity activity("loading the scene");
+        r.scene.scene = read_scene(request.scene, source, warn);
+    }
     r.scene.seconds_load =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
     Scene& scene = r.scene.scene;
     if (v.materials->lambertian) make_lambertian(scene.materials);
     r.scene.camera = choose_camera(scene, request.camera);
-    r.scene.bvh = build_bvh(scene);
-    r.scene.gpu = make_gpu_scene(scene, r.scene.bvh, r.scene.camera, s.width, s.height,
-                                 v.light_select->id);
+    {
+        const Activity activity("building the BVH");
+        r.scene.bvh = build_bvh(scene);
+    }
+    {
+        const Activity activity("laying out the scene for the devices");
+        r.scene.gpu = make_gpu_scene(scene, r.scene.bvh, r.scene.camera, s.width, s.height,
+                                     v.light_select->id);
+    }
     if (warn && scene.triangle_count() == 0) warn(request.scene + ": the scene has no triangles");
     if (warn && v.uses(kUsesLights) && !s.sky_light && r.scene.gpu.lights.empty())
         warn(request.scene + ": no emissive triangles: direct lighting is black" +

@@ -1,5 +1,7 @@
 #include "render/renderer.h"
 
+#include "common/activity.h"
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -65,14 +67,19 @@ void check_agreement(std::vector<std::unique_ptr<RenderWorker>>& workers, size_t
     std::vector<std::optional<BatchResult>> results(count);
     std::vector<std::thread> threads;
     std::vector<std::string> failures(count);
-    for (size_t i = 0; i < count; ++i)
-        threads.emplace_back([&, i] {
-            try {
-                results[i] = workers[i]->run(item);
-            } catch (const RuntimeError& e) {
-                failures[i] = e.what();
-            }
-        });
+    try {
+        for (size_t i = 0; i < count; ++i)
+            threads.emplace_back([&, i] {
+                try {
+                    results[i] = workers[i]->run(item);
+                } catch (const RuntimeError& e) {
+                    failures[i] = e.what();
+                }
+            });
+    } catch (const std::system_error&) {
+        for (std::thread& t : threads) t.join();  // no thread to be had: join, then tell it
+        throw;
+    }
     for (std::thread& t : threads) t.join();
     auto same = [&](size_t a, size_t b) {
         const auto &x = results[a]->sums, &y = results[b]->sums;
@@ -144,6 +151,7 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
         build_light_selection(rebuilt, plan.variants.light_select->id);
         return render(devices, rebuilt, plan, progress, control, warn, remote);
     }
+    const Activity activity("building the kernels and rendering");
     auto start = std::chrono::steady_clock::now();
     const RenderSettings& settings = plan.settings;
     const uint32_t pixels = uint32_t(settings.width) * uint32_t(settings.height);
@@ -256,10 +264,17 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
     // within a second), then each device's launches grow by its own measured speed.
     const uint64_t probe = std::clamp<uint64_t>(total_samples / (8 * workers.size()), 1024, 4096);
     std::vector<std::thread> threads;
-    for (auto& w : workers)
-        if (!w->report.retired)
-            threads.emplace_back(device_loop, std::ref(*w),
-                                 queue.take(fixed_batch > 0 ? fixed_batch : probe));
+    try {
+        for (auto& w : workers)
+            if (!w->report.retired)
+                threads.emplace_back(device_loop, std::ref(*w),
+                                     queue.take(fixed_batch > 0 ? fixed_batch : probe));
+    } catch (const std::system_error&) {
+        // No thread to be had (EAGAIN): those started end with the queue, then the error is told.
+        queue.abandon();
+        for (std::thread& t : threads) t.join();
+        throw;
+    }
 
     // Watch the clock, the interrupt flag and the progress until the devices are done.
     auto all_retired = [&] {

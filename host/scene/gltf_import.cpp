@@ -69,11 +69,13 @@ Scene import_default_scene(const tinygltf::Model& model, const std::string& path
         }
         if (node.camera != -1) {
             if (auto camera = gltf::read_camera(model, node.camera, world, node_index, diag)) {
+                camera->gltf_index = node.camera;
                 scene.cameras.push_back(*camera);
             }
         }
     });
     geometry.finish();
+    for (const tinygltf::Camera& camera : model.cameras) scene.gltf_camera_types.push_back(camera.type);
     // The images the used materials' texture slots name, once the walk has found them all.
     scene.images = gltf::decode_images(model, textures.image_sources(), diag);
     return scene;

@@ -20,5 +20,10 @@ constexpr double kWarnCoordinate = 1e10;
 // 2048), and 2^30 texels (4 GiB) over all the images a scene's materials use.
 constexpr unsigned kMaxImageSide = 16384;
 constexpr unsigned long long kMaxImageTexels = 1ull << 30;
+// Encoded image files, whose size nothing declares, checked before they are read (tinygltf reads
+// every image file, used or not): each at most 1 GiB, what the largest image allowed above holds
+// as 8-bit RGBA, and 4 GiB over all of a scene's image files.
+constexpr unsigned long long kMaxImageFileBytes = 1ull << 30;
+constexpr unsigned long long kMaxImageFilesBytes = 4ull << 30;
 
 }  // namespace mcrt::gltf

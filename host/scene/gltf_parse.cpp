@@ -13,6 +13,7 @@
 #include "common/regular_file.h"
 #include "scene/gltf_limits.h"
 #include "scene/gltf_types.h"
+#include "scene/gltf_uris.h"
 #include "scene/json_guard.h"
 
 namespace mcrt::gltf {
@@ -61,17 +62,21 @@ std::string one_line(const std::string& text) {
 }
 
 // Where one load reads files from, and what tinygltf's file callbacks (their user_data) keep
-// while it parses. From the disk only regular files below the scene's directory (or reached from
-// it by `../`) are read; tinygltf's fallback to the current directory is cut, and every refusal
-// (FIFO, directory, device, missing) is kept to name the real cause. From memory no file exists.
+// while it parses. From the disk only the regular files that the uris name are read, relative to
+// the scene's directory (or reached from it by `../`) or absolute; tinygltf's fallback to the
+// current directory is cut, and every refusal (FIFO, directory, device, missing) is kept to name
+// the real cause. From memory no file exists.
 struct FileAccess {
     enum class Origin { Disk, Bundle, Memory };
     Origin origin = Origin::Disk;
     FileBundle* record = nullptr;         // Disk: keeps a copy of what is read
     const FileBundle* bundle = nullptr;   // Bundle: read from here instead of the disk
     std::string base_prefix;              // the scene's directory and "/"
+    std::map<std::string, gltf::UriTarget> targets;  // by the path tinygltf asks for
+    uint64_t image_bytes = 0;             // image files read so far
     std::vector<std::string> files_read;  // external files, in the order read
     std::string first_refusal;            // refusals of optional files (images) tinygltf drops
+    std::string size_refusal;             // a file of the wrong size, named by its element
 };
 
 // One file, from the bundle when there is one, else from the disk (recorded when asked).
@@ -86,8 +91,41 @@ bool read_file(FileAccess& access, const std::string& path, std::vector<unsigned
         out = it->second;
         return true;
     }
-    if (!read_regular_file(path, out, why, kMaxFileBytes)) return false;
+    FileSizeLimits limits;
+    limits.max_bytes = kMaxFileBytes;
+    if (!read_regular_file(path, out, why, limits)) return false;
     if (access.record) (*access.record)[path] = out;
+    return true;
+}
+
+// What a uri names: a buffer is read up to its byteLength ("Buffers": the resource MUST be at
+// least byteLength long, so a longer file is valid) and refused when shorter; an image file, whose
+// size nothing declares, within kMaxImageFileBytes. Both before any byte is read.
+bool read_target(FileAccess& access, const gltf::UriTarget& target,
+                 std::vector<unsigned char>& out, std::string& why) {
+    if (access.origin == FileAccess::Origin::Bundle) return read_file(access, target.path, out, why);
+    FileSizeLimits limits;
+    if (target.buffer) {
+        if (target.byte_length > kMaxFileBytes) {
+            why = "byteLength " + std::to_string(target.byte_length) + " is more than 4 GiB";
+            access.size_refusal = target.element + ": " + why;
+            return false;
+        }
+        limits.min_bytes = limits.read_bytes = target.byte_length;
+    } else {
+        limits.max_bytes = std::min<uint64_t>(kMaxImageFileBytes, kMaxImageFilesBytes - access.image_bytes);
+    }
+    if (!read_regular_file(target.path, out, why, limits)) {
+        const bool size = why.compare(0, 6, "holds ") == 0;
+        if (size && target.buffer) why += " by its byteLength";
+        if (size && !target.buffer && access.image_bytes > 0)
+            why += " (of 4 GiB for all image files, " + std::to_string(access.image_bytes) +
+                   " bytes read before)";
+        if (size) access.size_refusal = target.element + ": uri '" + target.uri + "': " + why;
+        return false;
+    }
+    if (!target.buffer) access.image_bytes += out.size();
+    if (access.record) (*access.record)[target.path] = out;
     return true;
 }
 
@@ -97,7 +135,8 @@ bool file_exists(const std::string& path, void* user) {
     // none does, so a uri naming a file fails with tinygltf's "File not found".
     const auto* access = static_cast<const FileAccess*>(user);
     if (access->origin == FileAccess::Origin::Memory) return false;
-    return path.compare(0, access->base_prefix.size(), access->base_prefix) == 0;
+    return path.compare(0, access->base_prefix.size(), access->base_prefix) == 0 ||
+           access->targets.count(path);
 }
 bool file_read(std::vector<unsigned char>* out, std::string* error, const std::string& path,
                void* user) {
@@ -107,15 +146,27 @@ bool file_read(std::vector<unsigned char>* out, std::string* error, const std::s
         return false;
     }
     std::string why;
-    if (!read_file(*access, path, *out, why)) {
+    const auto target = access->targets.find(path);
+    const std::string& read_path = target != access->targets.end() ? target->second.path : path;
+    const bool ok = target != access->targets.end() ? read_target(*access, target->second, *out, why)
+                                                    : read_file(*access, path, *out, why);
+    if (!ok) {
         if (error) *error = why;
-        if (access->first_refusal.empty()) access->first_refusal = path + ": " + why;
+        if (access->first_refusal.empty()) access->first_refusal = read_path + ": " + why;
         return false;
     }
-    access->files_read.push_back(path);
+    access->files_read.push_back(read_path);
     return true;
 }
-std::string path_unchanged(const std::string& path, void*) { return path; }
+// tinygltf joins every uri to the scene's directory: an absolute path comes back as itself.
+std::string expand_path(const std::string& path, void* user) {
+    const auto* access = static_cast<const FileAccess*>(user);
+    const std::string& prefix = access->base_prefix;
+    if (!prefix.empty() && path.size() > prefix.size() && path[prefix.size()] == '/' &&
+        path.compare(0, prefix.size(), prefix) == 0)
+        return path.substr(prefix.size());
+    return path;
+}
 bool no_file_write(std::string* error, const std::string&, const std::vector<unsigned char>&,
                    void*) {
     if (error) *error = "not writable";
@@ -133,14 +184,15 @@ tinygltf::Model parse_gltf(const std::string& name, const std::vector<unsigned c
     check_json_nesting(name, bytes.data(), bytes.size(), binary);
     const char* json = reinterpret_cast<const char*>(bytes.data());
     size_t json_size = bytes.size();
-    if (!binary || glb_json_chunk(bytes.data(), bytes.size(), &json, &json_size))
-        check_gltf_property_types(name, reinterpret_cast<const unsigned char*>(json), json_size);
+    const bool has_json = !binary || glb_json_chunk(bytes.data(), bytes.size(), &json, &json_size);
+    if (has_json) check_gltf_property_types(name, reinterpret_cast<const unsigned char*>(json), json_size);
 
-    access.base_prefix = base_dir + "/";
+    access.base_prefix = base_dir.empty() || base_dir.back() == '/' ? base_dir : base_dir + "/";
+    if (has_json) access.targets = gltf::scan_uris(name, json, json_size, base_dir);
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(keep_encoded_image, nullptr);
     loader.SetFsCallbacks(
-        tinygltf::FsCallbacks{file_exists, path_unchanged, file_read, no_file_write, &access});
+        tinygltf::FsCallbacks{file_exists, expand_path, file_read, no_file_write, &access});
     const auto length = static_cast<unsigned int>(bytes.size());
     tinygltf::Model model;
     std::string error, warning;  // tinygltf's warnings concern images and unknown data
@@ -151,9 +203,12 @@ tinygltf::Model parse_gltf(const std::string& name, const std::vector<unsigned c
                     : loader.LoadASCIIFromString(&model, &error, &warning,
                                                  reinterpret_cast<const char*>(bytes.data()),
                                                  length, base_dir);
+    } catch (const std::bad_alloc&) {
+        throw;  // not the file's fault: out of host memory (run_cli names it)
     } catch (const std::exception& e) {
         throw InputError(name + ": " + e.what());
     }
+    if (!access.size_refusal.empty()) throw InputError(name + ": " + access.size_refusal);
     // An empty image file fails with a warning alone as its reason.
     if (!ok) throw InputError(name + ": " + one_line(error.empty() ? warning : error));
     if (!access.first_refusal.empty()) throw InputError(name + ": " + access.first_refusal);

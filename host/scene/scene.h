@@ -83,6 +83,7 @@ struct Camera {
     std::string name;
     glm::mat4 camera_to_world{1.0f};  // rigid part only: columns are right, up, back, eye
     float yfov = 0.785398f;           // vertical field of view, radians
+    int gltf_index = -1;              // its glTF `cameras` index; -1 for one made by mcrt
 };
 
 // A triangle soup in world space. Triangle t has vertices positions[3t .. 3t+2],
@@ -94,7 +95,8 @@ struct Scene {
     std::vector<glm::vec3> positions;
     std::vector<uint32_t> triangle_material;
     std::vector<Material> materials;
-    std::vector<Camera> cameras;  // in default-scene traversal order
+    std::vector<Camera> cameras;  // perspective camera nodes, in default-scene traversal order
+    std::vector<std::string> gltf_camera_types;  // per glTF camera: "perspective", "orthographic"
     std::vector<TextureImage> images;  // those the materials' texture slots name
     std::vector<glm::vec4> texcoords;  // per corner: .xy TEXCOORD_0, .zw TEXCOORD_1 (0 absent)
     // Per corner, world space, for materials with a normal texture (zero for the others): the

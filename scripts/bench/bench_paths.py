@@ -36,7 +36,7 @@ def main():
     p.add_argument("--spp", type=int, default=64)
     p.add_argument("--passes", type=int, default=4, help="Mitsuba passes (the first not timed)")
     p.add_argument("--variant", default="llvm_ad_rgb")
-    p.add_argument("--out", required=True)
+    p.add_argument("--out", type=mcrt_run.output_directory, required=True)
     mcrt_run.add_mcrt_option(p)
     args = p.parse_args()
     out = Path(args.out)

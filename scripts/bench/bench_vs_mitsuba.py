@@ -301,7 +301,7 @@ def main():
                    help="of %s (default all)" % ",".join(PAIRS))
     p.add_argument("--reference-spp", type=int, default=1024)
     p.add_argument("--variant", default="llvm_ad_rgb", help="Mitsuba variant")
-    p.add_argument("--out", required=True, help="directory for the table, JSON, references")
+    p.add_argument("--out", type=mcrt_run.output_directory, required=True, help="directory for the table, JSON, references")
     mcrt_run.add_mcrt_option(p)
     args = p.parse_args()
     for name, value in (("--width", args.width), ("--height", args.height), ("--spp", args.spp),

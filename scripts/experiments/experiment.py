@@ -389,7 +389,7 @@ def parse_args(argv=None):
     p.add_argument("--max-depth", type=int, default=1,
                    help="mcrt --max-depth of every render and of the auto reference (paths)")
     p.add_argument("--rr-depth", type=int, default=5, help="mcrt --rr-depth with --max-depth")
-    p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--out", type=mcrt_run.output_directory, required=True, help="output directory")
     p.add_argument("--quick", action="store_true",
                    help="32×32 image, spp 1,4,16 unless given, 1 repeat, 512 spp reference")
     mcrt_run.add_mcrt_option(p)

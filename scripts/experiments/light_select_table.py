@@ -133,7 +133,7 @@ def main():
     p.add_argument("--crop", type=lambda t: tuple(int(v) for v in t.split(",")),
                    help="X,Y,W of the equal-time crops (default the central half)")
     p.add_argument("--no-strips", action="store_true", help="skip the equal-time crops")
-    p.add_argument("--out", required=True)
+    p.add_argument("--out", type=mcrt_run.output_directory, required=True)
     mcrt_run.add_mcrt_option(p)
     a = p.parse_args()
     mcrt_run.check_choices("light selection", a.selections, "light_select", mcrt=a.mcrt)

@@ -47,7 +47,7 @@ def main():
                    help="summarise the results.csv already in --out instead of rendering again")
     p.add_argument("--materials", default="gltf", choices=["gltf", "lambert"],
                    help="how mcrt reads the surfaces (experiment.py --materials)")
-    p.add_argument("--out", required=True)
+    p.add_argument("--out", type=mcrt_run.output_directory, required=True)
     mcrt_run.add_mcrt_option(p)
     args = p.parse_args()
     out = Path(args.out)

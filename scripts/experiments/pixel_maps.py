@@ -56,7 +56,7 @@ def main():
     p.add_argument("--reference-spp", type=int, default=4096)
     p.add_argument("--reference-cache")
     mcrt_run.add_mcrt_option(p)
-    p.add_argument("--out", required=True)
+    p.add_argument("--out", type=mcrt_run.output_directory, required=True)
     args = p.parse_args()
     if len(args.spp) < 2:
         raise mcrt_run.ScriptError("--spp needs at least two levels for a slope")

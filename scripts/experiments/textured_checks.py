@@ -691,7 +691,7 @@ def check_encoding(path, gltf, r, res):
 def check_multi_uv(path, gltf, r, res):
     """Base colour read with TEXCOORD_0 and emission with TEXCOORD_1 (texCoord 1): the emissive
     logo, not the 'Multiple UVs not supported' text of TEXCOORD_0."""
-    cam_node = gltf.camera(None, 0)
+    cam_node = gltf.camera(None)
     cam = Camera(cam_node[0], cam_node[1], cam_node[2], cam_node[3], 256, 144)
     hits = Hits(gltf, cam, s=4)
     e = r.emission(path, cam)

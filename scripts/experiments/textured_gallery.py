@@ -149,7 +149,7 @@ def main():
     p.add_argument("--max-depth", type=int, default=4)
     p.add_argument("--sky", default="1", help="sky radiance, one value or R,G,B (default 1)")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--out", default=str(ROOT / "out" / "textured-gallery"),
+    p.add_argument("--out", type=mcrt_run.output_directory, default=str(ROOT / "out" / "textured-gallery"),
                    help="folder for the EXRs and stats")
     p.add_argument("--figure", default=str(ROOT / "docs" / "figures" / "textured-gallery.png"),
                    help="the gallery PNG ('' for none)")

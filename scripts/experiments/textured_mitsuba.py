@@ -150,7 +150,7 @@ def main():
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--mitsuba-python", default=str(ROOT / ".venv-mitsuba" / "bin" / "python"),
                    help="a Python with Mitsuba 3 (default .venv-mitsuba/bin/python)")
-    p.add_argument("--out", default=str(ROOT / "out" / "textured-mitsuba"))
+    p.add_argument("--out", type=mcrt_run.output_directory, default=str(ROOT / "out" / "textured-mitsuba"))
     mcrt_run.add_mcrt_option(p)
     args = p.parse_args()
     scenes = Path(args.scenes)

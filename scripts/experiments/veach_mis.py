@@ -93,7 +93,7 @@ def main():
                    default=[0.5, 1, 2, 4])
     p.add_argument("--reference-spp", type=int, default=4096)
     p.add_argument("--seed", type=int, default=1)
-    p.add_argument("--out", required=True)
+    p.add_argument("--out", type=mcrt_run.output_directory, required=True)
     mcrt_run.add_mcrt_option(p)
     args = p.parse_args()
     out = Path(args.out)

@@ -17,6 +17,7 @@ Errors are raised as ScriptError (one line, naming the command); `script_main` t
 one `NAME: error: ...` line and exit status 2, so no script prints a traceback for them.
 """
 
+import argparse
 import functools
 import importlib.util
 import json
@@ -231,6 +232,22 @@ def image_size(text):
     if width <= 0 or height <= 0:
         raise argparse.ArgumentTypeError("expected a positive size: %r" % text)
     return width, height
+
+
+def output_directory(text):
+    """argparse type of an --out DIR: a directory, or a path where one can be made. A file
+    there (or above it) is argparse's error ("argument --out: ... is a file, not a directory"),
+    one line and status 2, before any work."""
+    path = Path(text)
+    for above in [path] + list(path.parents):
+        if above.exists():
+            if not above.is_dir():
+                what = "is a file" if above == path else "lies under the file %s" % above
+                raise argparse.ArgumentTypeError("%s %s, not a directory" % (text, what))
+            if not os.access(above, os.W_OK | os.X_OK):
+                raise argparse.ArgumentTypeError("%s: %s is not writable" % (text, above))
+            break
+    return text
 
 
 def add_mcrt_option(parser):

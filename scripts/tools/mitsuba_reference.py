@@ -58,8 +58,8 @@ Mitsuba 3 scene and renders it:
              normal, which for a PLY mesh is cross(p1 − p0, p2 − p0): glTF's
              counter-clockwise front, as mcrt. A `doubleSided`
              emitter gets a second, flipped copy 1e-6·diag behind it;
-  camera     the first camera node (--camera K: the K-th, in default-scene traversal order, as
-             mcrt) or the bench camera of DESIGN.md, `perspective` with
+  camera     the first perspective camera node (--camera K: the first node of glTF camera K,
+             as mcrt) or the bench camera of DESIGN.md, `perspective` with
              fov_axis y and fov = yfov; the glTF camera looks down −Z, Mitsuba's down +Z, so the
              sensor's to_world is a look_at built from the node's eye, −Z axis and +Y axis;
              `hdrfilm` of W×H with the `box` reconstruction filter (every sample inside its
@@ -291,24 +291,32 @@ class Gltf:
         emission = [c * strength for c in m.get("emissiveFactor", [0, 0, 0])]
         return albedo, emission, bool(m.get("doubleSided", False))
 
-    def camera(self, bounds, index=0):
-        """(eye, forward, up, yfov radians): the index-th perspective camera node, else (no
-        camera at all) the bench camera."""
-        found = 0
+    def camera(self, bounds, index=None):
+        """(eye, forward, up, yfov radians): the first perspective camera node, or with `index`
+        the first node of glTF camera `index` (as mcrt's --camera K), else (no camera at all)
+        the bench camera."""
+        cameras = self.doc.get("cameras", [])
+        if index is not None:
+            if not 0 <= index < len(cameras):
+                raise ValueError("camera %d: the scene has %d cameras" % (index, len(cameras)))
+            if cameras[index].get("type") != "perspective":
+                raise ValueError("camera %d is %s; only perspective cameras are rendered"
+                                 % (index, cameras[index].get("type")))
+        found = False
         for node, world in self.walk():
             if "camera" in node:
-                cam = self.doc["cameras"][node["camera"]]
+                cam = cameras[node["camera"]]
                 if cam.get("type") != "perspective":
                     continue
-                if found < index:
-                    found += 1
+                found = True
+                if index is not None and node["camera"] != index:
                     continue
                 eye = world[:3, 3]
                 forward = -world[:3, 2] / np.linalg.norm(world[:3, 2])
                 up = world[:3, 1] / np.linalg.norm(world[:3, 1])
                 return eye, forward, up, cam["perspective"]["yfov"]
-        if found or index:
-            raise ValueError("camera %d: the scene has %d perspective cameras" % (index, found))
+        if index is not None:
+            raise ValueError("camera %d is on no node of the default scene" % index)
         lo, hi = bounds
         c, diag = (lo + hi) / 2, np.linalg.norm(hi - lo)
         eye = c + diag * np.array([0.35, 0.30, 0.55])
@@ -697,7 +705,7 @@ def integrator(max_depth, rr_depth, emitter_samples=1, bsdf_samples=1, null_surf
 
 
 def mitsuba_scene(mi, gltf, width, height, spp, scratch, max_depth=1, rr_depth=5, sky=None,
-                  materials="lambert", integrator_desc=None, camera=0, normal_maps=True):
+                  materials="lambert", integrator_desc=None, camera=None, normal_maps=True):
     """(scene dict, emitter count) of a glTF; PLY meshes are written to `scratch`. The
     integrator is integrator_desc when given, else integrator(max_depth, rr_depth). `camera`:
     the index of the scene's camera, or (eye, target, up, vertical fov in degrees), mcrt's
@@ -793,7 +801,7 @@ def import_mitsuba(variant):
 
 
 def load_scene(mi, path, width, height, spp, max_depth=1, rr_depth=5, sky=None,
-               materials="lambert", integrator_desc=None, camera=0, normal_maps=True,
+               materials="lambert", integrator_desc=None, camera=None, normal_maps=True,
                info=None):
     """(loaded Mitsuba scene, emitter count, seconds of mi.load_dict) of the glTF at `path`
     (mitsuba_scene's arguments); `info`, a dict, receives the integrator's description."""
@@ -924,8 +932,10 @@ def compare(mitsuba_rgb, mitsuba_var, mcrt_path, png_path):
 
 def camera_arguments(camera):
     """mcrt's options for the camera of mitsuba_scene."""
+    if camera is None:
+        return []
     if isinstance(camera, int):
-        return ["--camera", camera]
+        return ["--camera", str(camera)]
     eye, target, up, fov = camera
     return ["--look-from", ",".join(map(repr, eye)), "--look-at", ",".join(map(repr, target)),
             "--up", ",".join(map(repr, up)), "--fov", repr(fov)]
@@ -993,8 +1003,8 @@ def main():
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--materials", choices=["lambert", "gltf", "principled"], default="lambert",
                    help="how surfaces are converted (see materials above; default lambert)")
-    p.add_argument("--camera", type=int, default=0,
-                   help="the K-th camera of the scene, as mcrt's --camera (default 0)")
+    p.add_argument("--camera", type=int,
+                   help="glTF camera K, as mcrt's --camera (default: the first camera node)")
     p.add_argument("--look-from", type=vector, help="X,Y,Z: replaces the scene's camera, as mcrt's")
     p.add_argument("--look-at", type=vector,
                    help="X,Y,Z (with --look-from; --look-at=-1,2,3 where X is negative)")
