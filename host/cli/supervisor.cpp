@@ -194,12 +194,13 @@ void kill_and_reap(pid_t pid, int* status) {
 }
 
 // How the supervisor ends once the worker has: with its status, or one line for its death.
-int outcome(int status, int forwarded, const WorkerStage& w) {
+int outcome(int status, const WorkerStage& w) {
     if (WIFEXITED(status)) return WEXITSTATUS(status);
     if (!WIFSIGNALED(status)) return 1;
     const int sig = WTERMSIG(status);
-    if (sig == forwarded) {
-        // Ended by the stop signal's own action (before the render caught it): end the same way.
+    if (sig == SIGINT || sig == SIGTERM || sig == SIGHUP) {
+        // Ended by a stop signal's own action before the render caught it (the one forwarded, or
+        // one sent to the worker itself): end the same way, as one process would have.
         std::signal(sig, SIG_DFL);
         std::raise(sig);
         return 128 + sig;
@@ -239,7 +240,7 @@ int supervise(pid_t pid, int fd) {
         const pid_t done = ::waitpid(pid, &status, WNOHANG);
         if (done == pid) {
             if (fd >= 0) read_reports(fd, pending, w);
-            return outcome(status, forwarded, w);
+            return outcome(status, w);
         }
         if (done < 0 && errno != EINTR) return 1;  // not ours any more: nothing to wait for
 
