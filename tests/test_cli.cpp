@@ -598,3 +598,94 @@ TEST_CASE("every environment variable mcrt reads is read through one table and d
         CHECK(design.find(std::string("`") + e.name + "`") != std::string::npos);
     }
 }
+
+TEST_CASE("an empty value is refused for every option of every subcommand", "[cli][empty]") {
+    // The options are read from each subcommand's --help ("--name TYPE"), so one added later is
+    // covered too; the scene positional as well.
+    Sandbox help_box;
+    for (const std::string command : {"render", "bench", "integrate"}) {
+        const ProcessResult help = help_box.run({command, "--help"});
+        REQUIRE(help.exit_code == 0);
+        std::vector<std::string> options;
+        std::istringstream lines(help.out);
+        for (std::string line; std::getline(lines, line);) {
+            std::istringstream words(line);
+            std::string name, type;
+            words >> name >> type;
+            if (name.rfind("--", 0) == 0 && !type.empty() &&
+                type.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZ") == std::string::npos)
+                options.push_back(name);
+        }
+        CHECK(options.size() >= (command == "render" ? 20u : 5u));
+        if (command != "integrate") options.push_back("scene");
+        for (const std::string& option : options) {
+            Sandbox box;
+            std::vector<std::string> args = {command};
+            if (command != "integrate") args.push_back(option == "scene" ? "" : kCornell);
+            if (command == "render" && option != "--out") args = concat(args, {"--out", box.out("x.exr")});
+            if (option != "scene") args = concat(args, {option, ""});
+            ProcessResult r = box.run(args, 60);
+            INFO(describe(args) << "\n  stderr: " << r.err);
+            check_usage_error(r);
+            CHECK(r.err.find(option == "scene" ? "scene" : option + ":") != std::string::npos);
+            CHECK(r.seconds < 20);  // refused while parsing, not after a render
+            CHECK(box.files().empty());
+        }
+    }
+}
+
+TEST_CASE("non-finite samples are counted, warned about, and an image of nothing else is refused",
+          "[cli][nonfinite][estimator-file]") {
+    Sandbox box;
+    auto estimator = [&](const std::string& name, const std::string& value) {
+        const std::string path = (box.tmp.path() / name).string();
+        std::ofstream(path) << "float3 estimate(const SceneView* scene, const SurfacePoint* sp, "
+                               "const SampleStream* stream, uint* rays) {\n"
+                               "    return " << value << ";\n}\n";
+        return path;
+    };
+    const std::vector<std::string> size = {"--width", "16", "--height", "12", "--spp", "16", "--quiet"};
+    SECTION("some samples: one warning with their count and share, the count in the stats") {
+        // Infinite on the surfaces facing +x (the left wall), NaN nowhere else.
+        const std::string file = estimator("some.cl", "sp->n.x > 0.5f ? (float3)(1.0f / 0.0f) : (float3)(0.5f)");
+        ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("a.exr"), "--stats",
+                                          box.out("a.json"), "--estimator-file", file},
+                                         size));
+        REQUIRE(r.exit_code == 0);
+        const auto warnings = lines_starting_with(r.err, "mcrt: warning:");
+        REQUIRE(warnings.size() == 1);
+        const auto stats = nlohmann::json::parse(read_whole_file(box.out("a.json")));
+        const uint64_t bad = stats["nan_samples"];
+        CHECK(bad > 0);
+        CHECK(bad < 16 * 12 * 16);
+        char share[16];
+        std::snprintf(share, sizeof share, "%.1f%%", 100.0 * double(bad) / (16 * 12 * 16));
+        CHECK(warnings[0] == "mcrt: warning: " + std::to_string(bad) + " of 3072 samples (" + share +
+                                 ") were not finite (NaN or infinite) and were counted as 0");
+        CHECK(all_finite(read_exr(box.out("a.exr")).rgb));
+    }
+    SECTION("no non-finite sample: no warning") {
+        ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("a.exr"), "--stats",
+                                          box.out("a.json"), "--estimator-file",
+                                          estimator("fine.cl", "(float3)(0.5f)")},
+                                         size));
+        REQUIRE(r.exit_code == 0);
+        CHECK(lines_starting_with(r.err, "mcrt: warning:").empty());
+        CHECK(nlohmann::json::parse(read_whole_file(box.out("a.json")))["nan_samples"] == 0);
+    }
+    SECTION("every sample: exit 1, one error line, nothing written") {
+        // Inside the box looking at the back wall: every camera ray meets a surface.
+        for (const std::string value : {"(float3)(NAN)", "(float3)(1.0f / 0.0f)"}) {
+            ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("a.exr"), "--png",
+                                              box.out("a.png"), "--stats", box.out("a.json"),
+                                              "--estimator-file", estimator("all.cl", value),
+                                              "--look-from", "0,1,0", "--look-at", "0,1,-1", "--fov", "40"},
+                                             size));
+            INFO(value << ": " << r.err);
+            CHECK(r.exit_code == 1);
+            CHECK(lines_starting_with(r.err, "mcrt: error:").size() == 1);
+            CHECK(r.err.find("all 3072 samples were not finite") != std::string::npos);
+            CHECK(box.files().empty());
+        }
+    }
+}

@@ -3,6 +3,9 @@
 // temporary file survives any way the process can end, and a closed stderr pipe or a late
 // SIGTERM does not lose the image. The tests never point an output at a system file: FIFOs,
 // directories and devices are made in a temporary directory (mkfifo needs no privilege).
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/types.h>
@@ -13,6 +16,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "common/atomic_file.h"
 #include "common/output_paths.h"
@@ -52,6 +56,26 @@ std::vector<std::string> names_in(const fs::path& dir) {
 void write_text(const fs::path& path, const std::string& text) {
     std::ofstream out(path, std::ios::binary);
     out << text;
+}
+
+// A file's bytes and inode: "unchanged" means both.
+struct FileState {
+    std::string bytes;
+    ino_t inode = 0;
+    bool operator==(const FileState& o) const { return bytes == o.bytes && inode == o.inode; }
+};
+
+FileState state_of(const fs::path& path) {
+    struct stat st {};
+    REQUIRE(::stat(path.c_str(), &st) == 0);
+    return {read_whole_file(path), st.st_ino};
+}
+
+// The string header attribute `name` of the EXR at `path`.
+std::string exr_attribute(const std::string& path, const std::string& name) {
+    Imf::InputFile file(path.c_str());
+    const auto* value = file.header().findTypedAttribute<Imf::StringAttribute>(name);
+    return value ? value->value() : std::string();
 }
 
 void require_one_error(const ProcessResult& r, int status, const std::string& needle) {
@@ -155,7 +179,9 @@ TEST_CASE("a write that fails names the reason, exits 1 and leaves no temporary 
     for (const std::string tmpfile : {"", "MCRT_TEST_NO_TMPFILE=1"}) {
         DYNAMIC_SECTION("temporary " << (tmpfile.empty() ? "unnamed" : "named")) {
             std::vector<std::string> args = {MCRT_EXE, "render", kCornell, "--width", "64", "--height", "48",
-                                             "--spp", "16", "--quiet", "--out", dir / "a.exr"};
+                                             "--spp", "16", "--quiet", "--out", dir / "a.exr",
+                                             "--stats", dir / "a.json"};
+            write_text(dir / "a.json", "old stats");
             std::vector<std::string> env = {"MCRT_TEST_PAUSE=before-write",
                                             "MCRT_TEST_PAUSE_UNTIL=" + (logs / "go")};
             if (!tmpfile.empty()) env.push_back(tmpfile);
@@ -172,7 +198,9 @@ TEST_CASE("a write that fails names the reason, exits 1 and leaves no temporary 
             CHECK(WEXITSTATUS(status) == 1);
             CHECK(lines_starting_with(err, "mcrt: error:").size() == 1);
             CHECK(err.find("File too large") != std::string::npos);
-            CHECK(names_in(dir.path()).empty());
+            CHECK(names_in(dir.path()) == std::vector<std::string>{"a.json"});
+            CHECK(read_whole_file(dir / "a.json") == "old stats");
+            fs::remove(dir / "a.json");
         }
     }
 }
@@ -283,4 +311,187 @@ TEST_CASE("an image too large for host memory is refused before rendering", "[me
     const ProcessResult b = run_process(
         MCRT_EXE, {"bench", kCornell, "--width", "16384", "--height", "16384", "--repeats", "1"}, logs.path(), 60);
     require_one_error(b, 1, "memory");
+}
+
+TEST_CASE("an output through a symbolic link replaces the link's target and keeps the link",
+          "[outputs][hostile][links]") {
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    fs::create_directory(dir.path() / "real");
+    struct Link {
+        std::string name;                       // the link the option names
+        std::vector<std::pair<std::string, std::string>> chain;  // link → what it holds
+        std::string target;                     // the file that must receive the output
+    };
+    for (const std::string option : {"--out", "--png", "--stats"}) {
+        const std::string ext = option == "--out" ? ".exr" : option == "--png" ? ".png" : ".json";
+        const std::vector<Link> links = {
+            {"absolute", {{"absolute" + ext, dir / ("real/abs" + ext)}}, "real/abs" + ext},
+            {"relative", {{"relative" + ext, "real/rel" + ext}}, "real/rel" + ext},
+            {"chain", {{"chain" + ext, "middle" + ext}, {"middle" + ext, "real/end" + ext}}, "real/end" + ext},
+            {"dangling", {{"dangling" + ext, "real/new" + ext}}, "real/new" + ext},
+        };
+        for (const Link& link : links) {
+            DYNAMIC_SECTION(option << " through a " << link.name << " link") {
+                for (const auto& [name, to] : link.chain) fs::create_symlink(to, dir / name);
+                if (link.name != "dangling") write_text(dir / link.target, "old");
+                const std::string named = dir / link.chain.front().first;
+                std::vector<std::string> args = small_render(option == "--out" ? named : dir / "a.exr");
+                if (option != "--out") args = with(args, {option, named});
+                const ProcessResult r = run_process(MCRT_EXE, args, logs.path(), 60);
+                INFO(r.err);
+                REQUIRE(r.exit_code == 0);
+                for (const auto& [name, to] : link.chain) {
+                    CHECK(fs::is_symlink(dir / name));
+                    CHECK(fs::read_symlink(dir / name) == fs::path(to));
+                }
+                const std::string written = read_whole_file(dir / link.target);
+                CHECK(written.size() > 100);
+                if (option == "--stats") CHECK(nlohmann::json::parse(written)["seed"] == 0);
+                else if (option == "--out") CHECK(read_exr(dir / link.target).width == 16);
+                for (const fs::path& d : {dir.path(), dir.path() / "real"})
+                    for (const std::string& name : names_in(d)) CHECK(name.find(".tmp-") == std::string::npos);
+            }
+        }
+    }
+}
+
+TEST_CASE("integrate --out through a symbolic link replaces the target", "[outputs][hostile][links]") {
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    write_text(dir / "real.csv", "old");
+    fs::create_symlink("real.csv", dir / "link.csv");
+    const ProcessResult r = run_process(
+        MCRT_EXE, {"integrate", "--n", "16", "--repeats", "2", "--out", dir / "link.csv"}, logs.path(), 60);
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(fs::is_symlink(dir / "link.csv"));
+    CHECK(read_whole_file(dir / "real.csv").rfind("estimator,n,", 0) == 0);
+}
+
+TEST_CASE("/dev/stdout as an output: a redirected file is written, a pipe is refused",
+          "[outputs][hostile][links]") {
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    struct stat before {};
+    REQUIRE(::lstat("/dev/stdout", &before) == 0);
+    const std::string command = "exec '" + std::string(MCRT_EXE) + "' render '" + kCornell +
+                                "' --width 8 --height 8 --spp 16 --quiet --out '" + (dir / "a.exr") +
+                                "' --stats /dev/stdout";
+    SECTION("stdout redirected to a file") {
+        const ProcessResult r =
+            run_process("/bin/sh", {"-c", command + " > '" + (dir / "so.json") + "'"}, logs.path(), 60);
+        INFO(r.err);
+        REQUIRE(r.exit_code == 0);
+        CHECK(nlohmann::json::parse(read_whole_file(dir / "so.json"))["width"] == 8);
+    }
+    SECTION("stdout a pipe") {
+        const ProcessResult r = run_process("/bin/sh", {"-c", command + " | cat"}, logs.path(), 60);
+        CHECK(lines_starting_with(r.err, "mcrt: error:").size() == 1);
+        CHECK(r.err.find("--stats /dev/stdout: is a FIFO") != std::string::npos);
+        CHECK_FALSE(fs::exists(dir / "a.exr"));
+    }
+    struct stat after {};
+    REQUIRE(::lstat("/dev/stdout", &after) == 0);
+    CHECK(S_ISLNK(after.st_mode));
+    CHECK(after.st_ino == before.st_ino);
+}
+
+TEST_CASE("an output where no file can be created is refused before the scene is loaded",
+          "[outputs][hostile]") {
+    // The scene does not exist: an error about it would mean the outputs were checked after it.
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    write_text(dir / "file", "x");
+    struct Case {
+        std::string label, stats, reason;  // label: a section name that is the same every run
+    };
+    std::vector<Case> cases = {
+        {"under /proc", "/proc/mcrt-test.json", "cannot create a file in /proc"},
+        {"under a file", dir / "file/x.json", "file is not a directory"},
+    };
+    if (::geteuid() != 0) {  // root writes into a mode-555 directory regardless
+        fs::create_directory(dir.path() / "readonly");
+        fs::permissions(dir.path() / "readonly", fs::perms(0555));
+        cases.push_back({"in a read-only directory", dir / "readonly/x.json", "cannot create a file in"});
+    }
+    for (const Case& c : cases) {
+        DYNAMIC_SECTION("--stats " << c.label) {
+            const ProcessResult r = run_process(
+                MCRT_EXE, {"render", dir / "no-scene.gltf", "--out", dir / "a.exr", "--stats", c.stats},
+                logs.path(), 60);
+            require_one_error(r, 2, "--stats " + c.stats + ": ");
+            CHECK(r.err.find(c.reason) != std::string::npos);
+            CHECK(r.err.find("no-scene.gltf") == std::string::npos);
+            CHECK_FALSE(fs::exists(dir / "a.exr"));
+        }
+    }
+}
+
+TEST_CASE("the outputs of a render land together or not at all", "[outputs][hostile]") {
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    write_text(dir / "a.exr", "old image");
+    write_text(dir / "a.png", "old png");
+    write_text(dir / "a.json", "old stats");
+    const FileState exr = state_of(dir / "a.exr"), png = state_of(dir / "a.png"),
+                    json = state_of(dir / "a.json");
+    auto unchanged = [&] {
+        CHECK(state_of(dir / "a.exr") == exr);
+        CHECK(state_of(dir / "a.png") == png);
+        CHECK(state_of(dir / "a.json") == json);
+        CHECK(names_in(dir.path()) == std::vector<std::string>{"a.exr", "a.json", "a.png"});
+    };
+    SECTION("--stats that cannot be created: refused before rendering") {
+        const ProcessResult r = run_process(
+            MCRT_EXE, with(small_render(dir / "a.exr"), {"--png", dir / "a.png", "--stats", "/proc/x.json"}),
+            logs.path(), 60);
+        require_one_error(r, 2, "--stats /proc/x.json");
+        unchanged();
+    }
+    for (const std::string tmpfile : {"", "MCRT_TEST_NO_TMPFILE=1"}) {
+        DYNAMIC_SECTION("the stats' write fails after the EXR's and PNG's succeeded, temporary "
+                        << (tmpfile.empty() ? "unnamed" : "named")) {
+            // A 4x4 EXR is about 1.2 kB, the PNG 0.1 kB, the stats about 2 kB: a 1600-byte
+            // file-size limit fails the stats alone.
+            std::vector<std::string> args = {MCRT_EXE, "render", kCornell, "--width", "4", "--height", "4",
+                                             "--spp", "16", "--quiet", "--out", dir / "a.exr",
+                                             "--png", dir / "a.png", "--stats", dir / "a.json"};
+            std::vector<std::string> env = {"MCRT_TEST_PAUSE=before-write",
+                                            "MCRT_TEST_PAUSE_UNTIL=" + (logs / "go")};
+            if (!tmpfile.empty()) env.push_back(tmpfile);
+            fs::remove(logs / "go");
+            Child child(args, env, logs / "log");
+            REQUIRE(child.wait_for_text("paused at before-write", 60));
+            const struct rlimit limit = {1600, 1600};
+            REQUIRE(::prlimit(child.pid(), RLIMIT_FSIZE, &limit, nullptr) == 0);
+            write_text(logs / "go", "");
+            const int status = child.wait(60);
+            INFO(child.output());
+            REQUIRE(WIFEXITED(status));
+            CHECK(WEXITSTATUS(status) == 1);
+            CHECK(lines_starting_with(child.output(), "mcrt: error:").size() == 1);
+            CHECK(child.output().find("a.json: cannot write") != std::string::npos);
+            unchanged();
+        }
+    }
+}
+
+TEST_CASE("two renders into the same outputs leave one render's whole set", "[outputs][hostile]") {
+    // Render 1 stops inside its commit, after its EXR is renamed; render 2 must wait for it
+    // (it says so at the hook "commit-wait") and then put down its own pair.
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    auto args = [&](const std::string& seed) {
+        std::vector<std::string> a = with(small_render(dir / "a.exr"), {"--stats", dir / "a.json", "--seed", seed});
+        a.insert(a.begin(), MCRT_EXE);
+        return a;
+    };
+    Child first(args("1"), {"MCRT_TEST_PAUSE=commit", "MCRT_TEST_PAUSE_UNTIL=" + (logs / "go")}, logs / "log1");
+    REQUIRE(first.wait_for_text("paused at commit", 60));
+    Child second(args("2"), {"MCRT_TEST_PAUSE=commit-wait", "MCRT_TEST_PAUSE_SECONDS=0"}, logs / "log2");
+    REQUIRE(second.wait_for_text("paused at commit-wait", 60));
+    write_text(logs / "go", "");
+    const int status1 = first.wait(60), status2 = second.wait(60);
+    INFO(first.output() << second.output());
+    CHECK((WIFEXITED(status1) && WEXITSTATUS(status1) == 0));
+    CHECK((WIFEXITED(status2) && WEXITSTATUS(status2) == 0));
+    const auto stats = nlohmann::json::parse(read_whole_file(dir / "a.json"));
+    CHECK(exr_attribute(dir / "a.exr", "mcrt.seed") == "2");
+    CHECK(stats["seed"] == 2);
+    CHECK(names_in(dir.path()) == std::vector<std::string>{"a.exr", "a.json"});
 }

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <random>
@@ -274,12 +275,12 @@ TEST_CASE("write_atomically replaces the target and errors name the path", "[ima
     std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     CHECK(content == "new");
 
-    // On the named-temporary path (file systems without O_TMPFILE), a writer that creates
-    // nothing makes the rename fail with a RuntimeError naming the path.
+    // On the named-temporary path (file systems without O_TMPFILE), a writer that removes its
+    // temporary makes the rename fail with a RuntimeError naming the path.
     ::setenv("MCRT_TEST_NO_TMPFILE", "1", 1);
-    CHECK_THROWS_AS(write_atomically(path, [](const std::string&) {}), RuntimeError);
-    CHECK_THROWS_WITH(write_atomically(path, [](const std::string&) {}),
-                      Catch::StartsWith(path + ": "));
+    auto removing = [](const std::string& temporary) { std::remove(temporary.c_str()); };
+    CHECK_THROWS_AS(write_atomically(path, removing), RuntimeError);
+    CHECK_THROWS_WITH(write_atomically(path, removing), Catch::StartsWith(path + ": "));
     ::unsetenv("MCRT_TEST_NO_TMPFILE");
 }
 

@@ -128,6 +128,7 @@ int run_cli(int argc, char** argv) {
     add_bench_command(app, bench_options, bench_look);
     IntegrateOptions integrate_options;
     add_integrate_command(app, integrate_options);
+    refuse_empty_values(app);  // every string-valued option of every subcommand
 
     try {
         app.parse(argc, argv);

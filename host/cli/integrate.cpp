@@ -169,11 +169,9 @@ CLI::App* add_integrate_command(CLI::App& app, IntegrateOptions& o) {
 
 int run_integrate(const IntegrateOptions& o) {
     check_options(o);
-    if (!o.out.empty()) {
-        std::filesystem::path dir = std::filesystem::path(o.out).parent_path();
-        if (!dir.empty() && !std::filesystem::is_directory(dir))
-            throw InputError("--out " + o.out + ": directory " + dir.string() + " does not exist");
-    }
+    OutputSet outputs;  // checked, its temporary created, before any device work
+    outputs.add("--out", o.out);
+    outputs.prepare({});
     DeviceContext device(select_device(o.device, print_warning));
     std::string csv = integrate_csv(integrate_cosine_hemisphere(device, o));
     if (o.out.empty()) {
@@ -181,12 +179,11 @@ int run_integrate(const IntegrateOptions& o) {
         if (!std::cout) throw RuntimeError("cannot write to stdout");
         return 0;
     }
-    write_atomically(o.out, [&](const std::string& tmp) {
-        std::ofstream out(tmp, std::ios::binary);
-        out << csv;
-        out.close();
-        if (!out) throw RuntimeError(o.out + ": cannot write");
-    });
+    std::ofstream out(outputs.temporary(o.out), std::ios::binary | std::ios::trunc);
+    out << csv;
+    out.close();
+    if (!out) throw RuntimeError(o.out + ": cannot write");
+    outputs.commit();
     return 0;
 }
 

@@ -1,6 +1,7 @@
 #include "cli/render_command.h"
 
 #include <cerrno>
+#include <cstdio>
 #include <chrono>
 #include <csignal>
 #include <cstring>
@@ -21,6 +22,7 @@
 #include "common/error.h"
 #include "common/output_paths.h"
 #include "common/stop_signals.h"
+#include "common/test_hooks.h"
 #include "common/value_limits.h"
 #include "image/image.h"
 #include "image/image_check.h"
@@ -87,6 +89,26 @@ std::string help_list(const char* what, const Table& table) {
     std::string text = what;
     for (const auto& row : table) text += std::string("\n  ") + row.name + ": " + row.description;
     return text;
+}
+
+// Non-finite samples are counted as 0 (kernels/render.cl, reduce_chunks): say so, and refuse
+// an image that holds nothing else.
+void report_nonfinite_samples(uint64_t nonfinite, uint64_t samples) {
+    if (nonfinite == 0 || samples == 0) return;
+    const std::string count = std::to_string(nonfinite) + " of " + std::to_string(samples);
+    if (nonfinite >= samples)
+        throw RuntimeError("all " + std::to_string(samples) +
+                           " samples were not finite (NaN or infinite); no image written");
+    const double percent = 100.0 * double(nonfinite) / double(samples);
+    char share[32];
+    if (percent < 0.05)
+        std::snprintf(share, sizeof share, "under 0.1%%");
+    else if (percent > 99.95)
+        std::snprintf(share, sizeof share, "over 99.9%%");
+    else
+        std::snprintf(share, sizeof share, "%.1f%%", percent);
+    print_warning(count + " samples (" + share +
+                  ") were not finite (NaN or infinite) and were counted as 0");
 }
 
 }  // namespace
@@ -214,11 +236,15 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     auto start = std::chrono::steady_clock::now();
     if (o.width * int64_t(o.height) * o.spp >= (int64_t(1) << 40))
         throw InputError("--width × --height × --spp is too large");
-    const std::vector<OutputFile> outputs = {
-        {"--out", o.out}, {"--png", o.png}, {"--stats", o.stats}};
+    // Every output is checked and its temporary created before anything is loaded; they land
+    // together at the end, or none does (OutputSet).
+    OutputSet outputs;
+    outputs.add("--out", o.out);
+    outputs.add("--png", o.png);
+    outputs.add("--stats", o.stats);
     std::vector<std::string> inputs = {o.scene};
     if (!o.estimator_file.empty()) inputs.push_back(o.estimator_file);
-    check_outputs(outputs, inputs);
+    outputs.prepare(inputs);
     if (!o.estimator_file.empty()) report_to_supervisor("estimator " + o.estimator_file);
     const RenderRequest request = render_request(o);
 
@@ -229,7 +255,7 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     const PlannedRender planned = plan_render(request, source, print_warning);
     const RenderPlan& plan = planned.plan;
     const RenderSettings& settings = plan.settings;
-    check_outputs(outputs, inputs);  // its buffers too
+    outputs.check_inputs(inputs);  // its buffers too
     check_host_memory("a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " render",
                       render_host_bytes(o.width, o.height, settings.replicates));
     if (job) {
@@ -267,6 +293,7 @@ int render_here(const RenderOptions& o, RenderJob* job) {
         print_warning("stopped by " + result.stopped_by + " after " + std::to_string(result.spp) +
                       " of " + std::to_string(o.spp) + " samples per pixel; writing those");
 
+    report_nonfinite_samples(result.nan_samples, uint64_t(o.width) * o.height * result.spp);
     if (uint64_t bad = nonfinite_pixels(result.image))
         throw RuntimeError(std::to_string(bad) +
                            " pixels are not finite (radiance overflowed single "
@@ -286,22 +313,23 @@ int render_here(const RenderOptions& o, RenderJob* job) {
              ? "variance of the pixel mean from the spread of " + std::to_string(result.replicates) +
                    " independent replicate means"
              : "variance of the pixel mean: the samples' variance over their number"}};
-    write_exr(o.out, result.image, attributes);
-    if (!o.png.empty()) write_png(o.png, result.image, o.exposure);
+    test_pause("before-write");
+    write_exr_to(outputs.temporary(o.out), o.out, result.image, attributes);
+    if (!o.png.empty()) write_png_to(outputs.temporary(o.png), o.png, result.image, o.exposure);
 
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!o.stats.empty()) {
         nlohmann::json j =
             render_stats_json({o, planned, result, total, seconds_to_render});
         if (job) j["ranks"] = job->ranks_json(result.devices);
-        write_atomically(o.stats, [&](const std::string& tmp) {
-            std::ofstream out(tmp);
-            out << j.dump(2) << "\n";
-            if (!out)
-                throw RuntimeError(o.stats +
-                                   ": cannot write: " + std::strerror(errno ? errno : EIO));
-        });
+        errno = 0;
+        std::ofstream out(outputs.temporary(o.stats), std::ios::trunc);
+        out << j.dump(2) << "\n";
+        out.close();
+        if (!out)
+            throw RuntimeError(o.stats + ": cannot write: " + std::strerror(errno ? errno : EIO));
     }
+    outputs.commit();
     if (!o.quiet)
         std::cerr << "mcrt: wrote " << o.out << " (" << o.width << "x" << o.height << ", "
                   << result.spp << " spp, " << result.seconds_render << " s on the device)"

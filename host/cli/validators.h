@@ -20,4 +20,20 @@ inline const CLI::Validator kFinite(
     },
     "FINITE");
 
+// An empty value (`--out ""`, an unset shell variable) is a bad value, never "not given": it would
+// otherwise select a default or skip an output silently.
+inline const CLI::Validator kNotEmpty(
+    [](std::string& text) {
+        return text.empty() ? std::string("an empty value is not allowed") : std::string();
+    },
+    "NOT EMPTY");
+
+// Adds kNotEmpty to every option that takes a value, of `app` and all its subcommands.
+inline void refuse_empty_values(CLI::App& app) {
+    for (CLI::Option* option : app.get_options())
+        if (option->get_type_size_max() > 0) option->check(kNotEmpty);
+    for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+        refuse_empty_values(*sub);
+}
+
 }  // namespace mcrt

@@ -1,23 +1,26 @@
-// Write to a temporary file, then rename: readers see the old file or the whole new one, and no
+// Write to temporary files, then rename: readers see the old files or the whole new set, and no
 // temporary outlives its process (ROBUSTNESS.md "Outputs").
 #include "common/atomic_file.h"
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 #include <system_error>
 
 #include "common/error.h"
-#include "common/regular_file.h"
+#include "common/output_paths.h"
 #include "common/test_hooks.h"
 
 namespace mcrt {
@@ -53,53 +56,26 @@ pid_t temporary_owner(const std::string& file, const std::string& name) {
     }
 }
 
-[[noreturn]] void fail_rename(const std::string& path, int error) {
-    throw RuntimeError(path + ": cannot rename temporary file into place: " + std::strerror(error));
+fs::path directory_of(const fs::path& target) {
+    return target.parent_path().empty() ? fs::path(".") : target.parent_path();
 }
 
-// The O_TMPFILE path: true when the file was written and renamed into place, false when the file
-// system does not support unnamed temporaries (nothing was done then).
-bool write_unnamed(const fs::path& target, const fs::path& directory,
-                   const std::function<void(const std::string&)>& write) {
+// An unnamed inode in `directory` (O_TMPFILE, open(2)), -1 where the file system or the
+// platform has none, or /proc is missing to reopen it by.
+int open_unnamed(const fs::path& directory) {
 #ifdef O_TMPFILE
-    if (test_no_tmpfile()) return false;
+    if (test_no_tmpfile()) return -1;
     const int fd = ::open(directory.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
-    if (fd < 0) {
-        // EISDIR / EOPNOTSUPP / EINVAL: no O_TMPFILE here; other errors show again on the
-        // named path, with its own message.
-        return false;
-    }
+    if (fd < 0) return -1;  // EISDIR / EOPNOTSUPP / EINVAL, or an error the named path names
     const std::string proc_path = "/proc/self/fd/" + std::to_string(fd);
-    if (::access(proc_path.c_str(), W_OK) != 0) {  // no /proc: cannot reopen or link it
+    if (::access(proc_path.c_str(), W_OK) != 0) {
         ::close(fd);
-        return false;
+        return -1;
     }
-    try {
-        write(proc_path);
-        test_pause("write");
-    } catch (...) {
-        ::close(fd);  // the unnamed inode dies with its last descriptor
-        throw;
-    }
-    // linkat cannot replace, so the file gets its hidden name only for the rename's instant.
-    const fs::path temporary = temporary_sibling(target);
-    if (::linkat(AT_FDCWD, proc_path.c_str(), AT_FDCWD, temporary.c_str(), AT_SYMLINK_FOLLOW) != 0) {
-        const int error = errno;
-        ::close(fd);
-        throw RuntimeError(target.string() + ": cannot link the written file into " +
-                           directory.string() + ": " + std::strerror(error));
-    }
-    ::close(fd);
-    if (std::rename(temporary.c_str(), target.c_str()) != 0) {
-        const int error = errno;
-        std::error_code ec;
-        fs::remove(temporary, ec);
-        fail_rename(target.string(), error);
-    }
-    return true;
+    return fd;
 #else
-    (void)target, (void)directory, (void)write;
-    return false;
+    (void)directory;
+    return -1;
 #endif
 }
 
@@ -113,11 +89,166 @@ bool is_zombie(pid_t pid) {
     return paren != std::string::npos && paren + 2 < stat.size() && stat[paren + 2] == 'Z';
 }
 
+// Holds an exclusive flock(2) on each directory given, taken in sorted order so that two sets
+// over the same directories cannot deadlock; released by close(2).
+class DirectoryLocks {
+  public:
+    explicit DirectoryLocks(std::vector<std::string> directories) {
+        std::sort(directories.begin(), directories.end());
+        directories.erase(std::unique(directories.begin(), directories.end()), directories.end());
+        for (const std::string& dir : directories) {
+            const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+            if (fd < 0) continue;  // unlockable: the renames are still each atomic
+            if (::flock(fd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK) {
+                test_pause("commit-wait");  // another set holds it: the tests see this one wait
+                while (::flock(fd, LOCK_EX) != 0 && errno == EINTR) {
+                }
+            }
+            fds_.push_back(fd);
+        }
+    }
+    ~DirectoryLocks() {
+        for (int fd : fds_) ::close(fd);
+    }
+    DirectoryLocks(const DirectoryLocks&) = delete;
+    DirectoryLocks& operator=(const DirectoryLocks&) = delete;
+
+  private:
+    std::vector<int> fds_;
+};
+
 }  // namespace
+
+struct OutputSet::Output {
+    std::string option, path;   // as given
+    fs::path target;            // after its links: what the commit replaces
+    int fd = -1;                // the unnamed temporary, or -1
+    std::string temporary;      // what the writer opens: /proc/self/fd/N or the named sibling
+    fs::path linked;            // the name the temporary has during the commit
+
+    std::string name() const { return option.empty() ? path : option + " " + path; }
+
+    void remove_files() noexcept {
+        std::error_code ec;
+        if (fd >= 0) {
+            ::close(fd);  // the unnamed inode dies with its last descriptor
+            fd = -1;
+        } else if (!temporary.empty()) {
+            fs::remove(temporary, ec);
+        }
+        if (!linked.empty()) fs::remove(linked, ec);
+        temporary.clear();
+        linked.clear();
+    }
+};
+
+OutputSet::OutputSet() = default;
+
+OutputSet::~OutputSet() { discard(); }
+
+void OutputSet::add(const std::string& option, const std::string& path) {
+    if (path.empty()) return;
+    auto output = std::make_unique<Output>();
+    output->option = option;
+    output->path = path;
+    outputs_.push_back(std::move(output));
+}
+
+void OutputSet::check_inputs(const std::vector<std::string>& inputs) const {
+    std::vector<OutputFile> files;
+    for (const auto& output : outputs_) files.push_back({output->option, output->path, {}});
+    check_outputs(files, inputs);
+}
+
+void OutputSet::prepare(const std::vector<std::string>& inputs) {
+    std::vector<OutputFile> files;
+    for (const auto& output : outputs_) files.push_back({output->option, output->path, {}});
+    check_outputs(files, inputs);
+    for (size_t i = 0; i < outputs_.size(); ++i) {
+        Output& output = *outputs_[i];
+        output.target = files[i].target;
+        const fs::path directory = directory_of(output.target);
+        sweep_stale_temporaries(output.target.string());
+        output.fd = open_unnamed(directory);
+        if (output.fd >= 0) {
+            output.temporary = "/proc/self/fd/" + std::to_string(output.fd);
+            continue;
+        }
+        // The named temporary, created now: a directory that takes no new file is refused
+        // before any work, not after it.
+        const fs::path named = temporary_sibling(output.target);
+        const int fd = ::open(named.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd < 0) {
+            const int error = errno;
+            discard();
+            throw InputError(output.name() + ": cannot create a file in " +
+                             directory.string() + ": " + std::strerror(error));
+        }
+        ::close(fd);
+        output.temporary = named.string();
+    }
+    prepared_ = true;
+}
+
+const std::string& OutputSet::temporary(const std::string& path) const {
+    for (const auto& output : outputs_)
+        if (output->path == path && !output->temporary.empty()) return output->temporary;
+    throw RuntimeError(path + ": not an output of this command, or already written");
+}
+
+void OutputSet::commit() {
+    if (!prepared_) throw RuntimeError("output set committed before it was prepared");
+    std::vector<std::string> directories;
+    for (const auto& output : outputs_) directories.push_back(directory_of(output->target).string());
+    test_pause("write");
+    try {
+        DirectoryLocks locks(directories);
+        // Every temporary gets its name first (linkat cannot replace, so an unnamed one is
+        // linked as a hidden sibling), then the renames: a failure before them changes nothing.
+        for (const auto& output : outputs_) {
+            struct stat st {};
+            if (::stat(output->target.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+                throw RuntimeError(output->name() + ": became something else than a regular file; not replaced");
+            }
+            if (output->fd < 0) {
+                output->linked = output->temporary;
+                continue;
+            }
+            const fs::path hidden = temporary_sibling(output->target);
+            if (::linkat(AT_FDCWD, output->temporary.c_str(), AT_FDCWD, hidden.c_str(),
+                         AT_SYMLINK_FOLLOW) != 0) {
+                throw RuntimeError(output->name() + ": cannot link the written file into " +
+                                   directory_of(output->target).string() + ": " + std::strerror(errno));
+            }
+            output->linked = hidden;
+        }
+        bool first = true;
+        for (const auto& output : outputs_) {
+            if (std::rename(output->linked.c_str(), output->target.c_str()) != 0) {
+                throw RuntimeError(output->target.string() +
+                                   ": cannot rename temporary file into place: " + std::strerror(errno));
+            }
+            output->linked.clear();
+            if (output->fd < 0) output->temporary.clear();  // it is the target now
+            if (first) test_pause("commit");
+            first = false;
+        }
+    } catch (...) {
+        discard();
+        throw;
+    }
+    discard();  // closes the unnamed descriptors
+    prepared_ = false;
+}
+
+void OutputSet::discard() noexcept {
+    for (const auto& output : outputs_) output->remove_files();
+    prepared_ = false;
+}
 
 int sweep_stale_temporaries(const std::string& path) {
     const fs::path target(path);
-    const fs::path directory = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+    const fs::path directory = directory_of(target);
     const std::string name = target.filename().string();
     int removed = 0;
     std::error_code ec;
@@ -135,36 +266,12 @@ int sweep_stale_temporaries(const std::string& path) {
 
 void write_atomically(const std::string& path,
                       const std::function<void(const std::string&)>& write) {
-    fs::path target(path);
-    // rename(2) is atomic only within one file system, so the temporary lives beside the target.
-    fs::path directory = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-    std::error_code ec;
-    if (!fs::is_directory(directory, ec)) {
-        throw InputError(path + ": directory does not exist");
-    }
-    // rename(2) replaces whatever has the name: a device, a FIFO, an empty directory.
-    struct stat st {};
-    if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
-        throw InputError(path + ": is " + file_kind_name(st.st_mode) + "; refusing to replace it");
-    }
-    sweep_stale_temporaries(path);
+    OutputSet set;
+    set.add("", path);
+    set.prepare({});
     test_pause("before-write");
-
-    if (write_unnamed(target, directory, write)) return;
-
-    fs::path temporary = temporary_sibling(target);
-    try {
-        write(temporary.string());
-        test_pause("write");
-    } catch (...) {
-        fs::remove(temporary, ec);
-        throw;
-    }
-    if (std::rename(temporary.c_str(), target.c_str()) != 0) {
-        int error = errno;
-        fs::remove(temporary, ec);
-        fail_rename(path, error);
-    }
+    write(set.temporary(path));
+    set.commit();
 }
 
 }  // namespace mcrt

@@ -9,8 +9,10 @@ namespace mcrt {
 
 // When MCRT_TEST_PAUSE equals `point`, writes "mcrt: test: paused at POINT" to stderr and sleeps
 // MCRT_TEST_PAUSE_SECONDS (default 20) seconds, signals notwithstanding, or until the file
-// MCRT_TEST_PAUSE_UNTIL exists. Otherwise nothing. Points: "before-write" and "write" (each
-// output, before its temporary exists and after it is written), "exit" (after the command).
+// MCRT_TEST_PAUSE_UNTIL exists. Otherwise nothing. Points: "before-write" (the outputs'
+// temporaries exist, nothing is written yet), "write" (all written, before the commit),
+// "commit" (inside the commit, after the first rename), "commit-wait" (another process holds
+// an output directory's lock; this one waits for it next), "exit" (after the command).
 void test_pause(const char* point);
 
 // True when MCRT_TEST_NO_TMPFILE is set: outputs take the named-temporary path that file systems

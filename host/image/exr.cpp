@@ -76,8 +76,8 @@ void write_exr_file(const std::string& temporary, const std::string& path, const
 
 }  // namespace
 
-void write_exr(const std::string& path, const Image& image,
-               const std::map<std::string, std::string>& attributes) {
+void write_exr_to(const std::string& file, const std::string& path, const Image& image,
+                  const std::map<std::string, std::string>& attributes) {
     const size_t floats = 3 * size_t(image.width) * size_t(image.height);
     if (image.width <= 0 || image.height <= 0 || image.rgb.size() != floats ||
         image.variance.size() != floats) {
@@ -85,15 +85,20 @@ void write_exr(const std::string& path, const Image& image,
                            std::to_string(image.height) +
                            " pixels is empty or its arrays have the wrong size");
     }
+    try {
+        write_exr_file(file, path, image, attributes);
+    } catch (const RuntimeError&) {
+        throw;
+    } catch (const std::exception& e) {
+        // OpenEXR throws Iex exceptions (std::exception) for I/O and header errors.
+        throw RuntimeError(path + ": cannot write EXR: " + e.what());
+    }
+}
+
+void write_exr(const std::string& path, const Image& image,
+               const std::map<std::string, std::string>& attributes) {
     write_atomically(path, [&](const std::string& temporary) {
-        try {
-            write_exr_file(temporary, path, image, attributes);
-        } catch (const RuntimeError&) {
-            throw;
-        } catch (const std::exception& e) {
-            // OpenEXR throws Iex exceptions (std::exception) for I/O and header errors.
-            throw RuntimeError(path + ": cannot write EXR: " + e.what());
-        }
+        write_exr_to(temporary, path, image, attributes);
     });
 }
 

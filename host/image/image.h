@@ -22,10 +22,18 @@ struct Image {
 void write_exr(const std::string& path, const Image& image,
                const std::map<std::string, std::string>& attributes = {});
 
+// The same into `file`, opened and truncated (an OutputSet's temporary); messages name `path`.
+void write_exr_to(const std::string& file, const std::string& path, const Image& image,
+                  const std::map<std::string, std::string>& attributes = {});
+
 // Reads what write_exr wrote (variance zero when absent). Throws InputError.
 Image read_exr(const std::string& path);
 
 // 8-bit sRGB PNG of rgb × 2^exposure, clamped. Written atomically.
 void write_png(const std::string& path, const Image& image, float exposure = 0.0f);
+
+// The same into `file`, opened and truncated (an OutputSet's temporary); messages name `path`.
+void write_png_to(const std::string& file, const std::string& path, const Image& image,
+                  float exposure = 0.0f);
 
 }  // namespace mcrt

@@ -32,7 +32,8 @@ uint8_t to_8bit(double linear) {
 
 }  // namespace
 
-void write_png(const std::string& path, const Image& image, float exposure) {
+void write_png_to(const std::string& file, const std::string& path, const Image& image,
+                  float exposure) {
     const size_t floats = 3 * size_t(image.width) * size_t(image.height);
     if (image.width <= 0 || image.height <= 0 || image.rgb.size() != floats) {
         throw RuntimeError(path + ": image of " + std::to_string(image.width) + "x" +
@@ -57,15 +58,18 @@ void write_png(const std::string& path, const Image& image, float exposure) {
         throw RuntimeError(path + ": cannot encode PNG");
     }
 
+    errno = 0;
+    std::ofstream out(file, std::ios::binary | std::ios::trunc);
+    out.write(encoded.data(), std::streamsize(encoded.size()));
+    out.close();
+    if (out.fail()) {
+        throw RuntimeError(path + ": cannot write PNG: " + std::strerror(errno ? errno : EIO));
+    }
+}
+
+void write_png(const std::string& path, const Image& image, float exposure) {
     write_atomically(path, [&](const std::string& temporary) {
-        errno = 0;
-        std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
-        file.write(encoded.data(), std::streamsize(encoded.size()));
-        file.close();
-        if (file.fail()) {
-            throw RuntimeError(path + ": cannot write PNG: " +
-                               std::strerror(errno));
-        }
+        write_png_to(temporary, path, image, exposure);
     });
 }
 
