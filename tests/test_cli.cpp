@@ -612,6 +612,7 @@ TEST_CASE("an empty value is refused for every option of every subcommand", "[cl
             std::istringstream words(line);
             std::string name, type;
             words >> name >> type;
+            type = type.substr(0, type.find_first_of(":="));  // "INT:INT in [1 - 16384]=1024"
             if (name.rfind("--", 0) == 0 && !type.empty() &&
                 type.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZ") == std::string::npos)
                 options.push_back(name);

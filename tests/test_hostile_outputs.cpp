@@ -459,7 +459,7 @@ TEST_CASE("the outputs of a render land together or not at all", "[outputs][host
             Child child(args, env, logs / "log");
             REQUIRE(child.wait_for_text("paused at before-write", 60));
             const struct rlimit limit = {1600, 1600};
-            REQUIRE(::prlimit(child.pid(), RLIMIT_FSIZE, &limit, nullptr) == 0);
+            REQUIRE(::prlimit(child.render_pid(), RLIMIT_FSIZE, &limit, nullptr) == 0);
             write_text(logs / "go", "");
             const int status = child.wait(60);
             INFO(child.output());

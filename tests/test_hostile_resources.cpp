@@ -257,7 +257,7 @@ TEST_CASE("experiment and bench scripts refuse an --out naming a file in argpars
     }
 }
 
-TEST_CASE("--camera K names glTF camera K, an orthographic one refused", "[gltf][cli]") {
+TEST_CASE("the camera option names glTF camera K, an orthographic one refused", "[gltf][cli]") {
     TempDir dir("mcrt-resources");
     write_file(dir / "a.bin", triangle_bytes(120));
     std::string text = scene_text("a.bin");

@@ -268,9 +268,11 @@ int supervise(pid_t pid, int fd) {
             g_terminal_stop = 0;
             const Clock::time_point stopped = Clock::now();
             ::kill(pid, SIGSTOP);
-            std::signal(SIGTSTP, SIG_DFL);
-            std::raise(SIGTSTP);  // returns once continued (fg, bg, SIGCONT)
-            catch_terminal_stop();
+            // SIGSTOP, not SIGTSTP: in an orphaned process group (a child of a test runner, a
+            // daemon) the kernel discards SIGTSTP's default stop (POSIX job control), which
+            // would leave the worker stopped and this process running. Returns once continued
+            // (fg, bg, SIGCONT); a shell sees the same stopped job either way.
+            std::raise(SIGSTOP);
             ::kill(pid, SIGCONT);
             const Clock::duration paused = Clock::now() - stopped;
             forwarded_at += paused;

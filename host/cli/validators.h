@@ -26,7 +26,7 @@ inline const CLI::Validator kNotEmpty(
     [](std::string& text) {
         return text.empty() ? std::string("an empty value is not allowed") : std::string();
     },
-    "NOT EMPTY");
+    "");  // no word in --help: every option has it
 
 // Adds kNotEmpty to every option that takes a value, of `app` and all its subcommands.
 inline void refuse_empty_values(CLI::App& app) {
