@@ -66,10 +66,22 @@ std::string error_caused_by(const std::string& log, const std::string& file,
                                                line.find("note") != std::string::npos && !first.empty()) {
             size_t digits = at + file.size() + 1, end = digits;
             while (end < line.size() && std::isdigit(static_cast<unsigned char>(line[end]))) ++end;
-            if (end > digits) return file + ":" + line.substr(digits, end - digits) + ": " + first;
+            if (end > digits) {
+                // "mcrt's kernels already define 'render' (render.cl:13:13: conflicting ...)",
+                // as where no note names the line (below).
+                const size_t open = first.find('\''), close = first.find('\'', open + 1);
+                const std::string name = close == std::string::npos
+                                             ? std::string()
+                                             : " '" + first.substr(open + 1, close - open - 1) + "'";
+                return file + ":" + line.substr(digits, end - digits) +
+                       ": mcrt's kernels already define" + (name.empty() ? " a name of it" : name) +
+                       " (" + first + ")";
+            }
         }
         if (first.empty() && line.find("error") != std::string::npos) {
             first = line.rfind("error: ", 0) == 0 ? line.substr(7) : line;
+            // Intel's "render.cl:13:13: error: conflicting ..." reads as PoCL's.
+            if (size_t e = first.find(": error: "); e != std::string::npos) first.erase(e + 2, 7);
         }
     }
     if (first.empty()) return "";
