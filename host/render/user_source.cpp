@@ -51,6 +51,7 @@ private:
     void directives();
     void directive(size_t first, size_t last);
     Tri evaluate(size_t first, size_t last) const;
+    Tri condition(const std::string& d, size_t first, size_t last) const;
     bool value_of(const std::vector<Token>& in, uint64_t& value) const;
     void code(const std::string& required_function, UserSource& out);
     std::string quote(size_t first, size_t last) const;
@@ -514,6 +515,25 @@ bool Checker::value_of(const std::vector<Token>& in, uint64_t& value) const {
 }
 
 // One directive, tokens [first, last): tokens_[first] is its `#`.
+// The condition of `#if`/`#elif EXPR`, or of `#ifdef`/`#ifndef`/`#elifdef`/`#elifndef NAME`
+// (`#ifdef X` is `#if defined X`): what the file's own macros decide, else unknown.
+Tri Checker::condition(const std::string& d, size_t first, size_t last) const {
+    if (d == "if" || d == "elif") {
+        for (size_t k = first + 2; k < last; ++k)
+            if (tokens_[k].kind == Kind::Ident && probes_files(tokens_[k].text))
+                fail_at(tokens_[k], quote(first, last) +
+                                        ": an estimator file may not look for other files");
+        return evaluate(first + 2, last);
+    }
+    Tri c = kMaybe;
+    if (first + 2 < last && tokens_[first + 2].kind == Kind::Ident) {
+        auto it = macros_.find(tokens_[first + 2].text);
+        if (it != macros_.end() && it->second.state != Macro::Unknown)
+            c = it->second.state == Macro::Undefined ? kNo : kYes;
+    }
+    return d == "ifndef" || d == "elifndef" ? tri_not(c) : c;
+}
+
 void Checker::directive(size_t first, size_t last) {
     const Token& hash = tokens_[first];
     const std::string d = first + 1 < last ? tokens_[first + 1].text : "";
@@ -521,26 +541,7 @@ void Checker::directive(size_t first, size_t last) {
     const Tri reach = active();
     if (named && conditional_directive(d)) {
         if (d == "if" || d == "ifdef" || d == "ifndef") {
-            Tri c = kNo;
-            if (reach != kNo) {
-                if (d == "if") {
-                    for (size_t k = first + 2; k < last; ++k)
-                        if (tokens_[k].kind == Kind::Ident && probes_files(tokens_[k].text))
-                            fail_at(tokens_[k], quote(first, last) +
-                                                    ": an estimator file may not look for other files");
-                    c = evaluate(first + 2, last);
-                } else {
-                    c = kMaybe;
-                    if (first + 2 < last && tokens_[first + 2].kind == Kind::Ident) {
-                        // `#ifdef X` is `#if defined X`.
-                        auto it = macros_.find(tokens_[first + 2].text);
-                        c = it == macros_.end() || it->second.state == Macro::Unknown
-                                ? kMaybe
-                                : it->second.state == Macro::Undefined ? kNo : kYes;
-                    }
-                    if (d == "ifndef") c = tri_not(c);
-                }
-            }
+            const Tri c = reach != kNo ? condition(d, first, last) : kNo;
             if (stack_.size() >= 4096) fail_at(hash, "conditionals nested more than 4096 deep");
             stack_.push_back({reach, kNo, c, false, first});
             return;
@@ -559,24 +560,7 @@ void Checker::directive(size_t first, size_t last) {
             return;
         }
         // #elif (and clang's #elifdef, #elifndef): decided only where no earlier branch surely was.
-        Tri c = kNo;
-        if (top.parent != kNo && top.taken != kYes) {
-            if (d == "elif") {
-                for (size_t k = first + 2; k < last; ++k)
-                    if (tokens_[k].kind == Kind::Ident && probes_files(tokens_[k].text))
-                        fail_at(tokens_[k], quote(first, last) +
-                                                ": an estimator file may not look for other files");
-                c = evaluate(first + 2, last);
-            } else {
-                c = kMaybe;
-                if (first + 2 < last && tokens_[first + 2].kind == Kind::Ident) {
-                    auto it = macros_.find(tokens_[first + 2].text);
-                    if (it != macros_.end() && it->second.state != Macro::Unknown)
-                        c = it->second.state == Macro::Undefined ? kNo : kYes;
-                }
-                if (d == "elifndef") c = tri_not(c);
-            }
-        }
+        const Tri c = top.parent != kNo && top.taken != kYes ? condition(d, first, last) : kNo;
         top.current = tri_and(tri_not(top.taken), c);
         return;
     }
