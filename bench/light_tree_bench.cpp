@@ -91,7 +91,9 @@ int main(int argc, char** argv) {
         if (devices.empty()) throw RuntimeError("no OpenCL device");
         DeviceContext d(devices.front());
         cl::Program program = build_program(
-            d.context, d.info.device, kernel_source("light_select_bench.cl"), "-cl-std=CL1.2");
+            d.context, d.info.device, kernel_source("light_select_bench.cl"),
+            // rng.cl wants a sampler; the device's options as the renderer's (correct rounding).
+            "-cl-std=CL1.2 -D SAMPLER_INDEPENDENT" + device_program_options(d.info));
         cl::Kernel kernel = make_kernel(program, "light_select_bench");
         // Shading points: the cube's points with random normals, 4096 of them.
         std::mt19937 rng(2);
