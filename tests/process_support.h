@@ -11,6 +11,7 @@
 #include <atomic>
 #include <cerrno>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -23,6 +24,16 @@
 extern char** environ;
 
 namespace mcrt::test {
+
+// Under AddressSanitizer the sanitizer catches a child's SIGSEGV itself and exits 1 with its
+// report; the tests of deaths by a signal let the signal through, as in a release build, so that
+// mcrt's supervisor sees the death (children inherit ASAN_OPTIONS).
+inline void let_segv_through_sanitizer() {
+#if defined(__SANITIZE_ADDRESS__)
+    const char* old = std::getenv("ASAN_OPTIONS");
+    ::setenv("ASAN_OPTIONS", (std::string(old ? old : "") + ":handle_segv=0").c_str(), 1);
+#endif
+}
 
 struct ProcessResult {
     int exit_code = -1;     // exit status when the child exited, else -1

@@ -340,6 +340,7 @@ TEST_CASE("an estimator that crashes under mpirun: an error line per rank naming
     // Each rank's supervisor (host/cli/supervisor.h) outlives its render's SIGSEGV: one line
     // (rank 0's, then "rank 1: ..."), and mpirun ends the job with a non-zero status.
     mpirun();
+    let_segv_through_sanitizer();
     TempDir dir;
     {
         std::ofstream crash(dir / "crash.cl");

@@ -129,6 +129,7 @@ TEST_CASE("a hanging estimator is stopped by one SIGTERM or one SIGINT within th
 
 TEST_CASE("an estimator that crashes its process costs one error line naming the signal",
           "[supervisor][cli]") {
+    let_segv_through_sanitizer();
     const std::pair<const char*, const char*> crashes[] = {
         {"a wild global pointer", "    *(global volatile int*)(0x10) = 1;\n    return (float3)(0.0f);"},
         {"a private index far out of bounds",
