@@ -1,91 +1,104 @@
 /* Choosing a light by walking the light tree (host/render/light_tree.h) from the root: at each
- * inner node one child by the children's importance at the shading point, from one number
- * rescaled at every level (Conty Estevez & Kulla 2018; pbrt-v4's BVHLightSampler), and the pmf
- * of a given light by walking its stored path with the same arithmetic. */
+ * node one of its four slots by the slots' importance at the shading point, from one number
+ * rescaled at every level (Conty Estevez & Kulla 2018; pbrt-v4's BVHLightSampler, four wide),
+ * and the pmf of a given light by walking its stored path with the same arithmetic. */
 #ifndef MCRT_LIGHT_TREE_CL
 #define MCRT_LIGHT_TREE_CL
 
 #include "discrete.cl"
 #include "shared_types.h"
 
-/* cos(max(0, θa − θb)) and sin(max(0, θa − θb)) from the sines and cosines of θa, θb ∈ [0, π]
- * (pbrt-v4's cosSubClamped / sinSubClamped). */
-inline float cos_sub_clamped(float sin_a, float cos_a, float sin_b, float cos_b) {
-    return cos_a > cos_b ? 1.0f : cos_a * cos_b + sin_a * sin_b;
-}
-inline float sin_sub_clamped(float sin_a, float cos_a, float sin_b, float cos_b) {
-    return cos_a > cos_b ? 0.0f : sin_a * cos_b - cos_a * sin_b;
-}
-
-inline float safe_sqrt1m(float c) { return sqrt(max(0.0f, 1.0f - c * c)); }
-
-/* Importance of a node at the shading point p with unit normal n (on the side the light must
- * reach): φ · cosθ'_light / d² · cosθ'_receiver, where the primes are the least angles that
- * the node's box and cone allow (Conty Estevez & Kulla 2018, eq. 3; pbrt-v4 LightBounds::
- * Importance). 0 when no light below can reach p's hemisphere. The receiver's bound is
- * one-sided because every BSDF here reflects only (a transmissive one would take |cos|). */
-inline float light_node_importance(global const LightTreeNode* node, float3 p, float3 n) {
-    float3 c = 0.5f * (node->lo.xyz + node->hi.xyz);
-    float3 to_p = p - c;
-    float d2 = dot(to_p, to_p);
-    float r = node->radius, r2 = r * r; /* the box's bounding sphere */
+/* Importance of a node's four slots at the shading point p with unit normal n (on the side the
+ * light must reach), one vector component each: φ · cosθ'_light · cosθ'_receiver / d², where
+ * the primes are the least angles that the slot's bounding sphere and cone allow (Conty Estevez
+ * & Kulla 2018, eq. 3; pbrt-v4 LightBounds::Importance), every angle held as its cosine and sine
+ * (pbrt-v4's cosSubClamped / sinSubClamped): no trigonometry. 0 where no light below can reach
+ * p's hemisphere, or for an empty slot (φ = 0, cos θ_e = 1). The receiver's bound is one-sided
+ * because every BSDF here reflects only (a transmissive one would take |cos|). */
+inline float4 light_slot_importance(global const LightTreeNode* node, float3 p, float3 n) {
+    const float4 zero = (float4)(0.0f), one = (float4)(1.0f);
+    float4 dx = p.x - node->x, dy = p.y - node->y, dz = p.z - node->z; /* centre → p */
+    float4 d2 = dx * dx + dy * dy + dz * dz;
+    float4 r = node->radius, r2 = r * r;
     /* The distance is clamped to the bounding sphere's radius so that a point near or inside
      * the box does not get an unbounded importance. pbrt-v4 writes max(d², |diagonal|/2),
      * comparing a squared distance with a length (its scale-dependent slip); this compares
      * squares. */
-    float d2_clamped = max(d2, r2);
-    float inv_d = d2 > 0.0f ? 1.0f / sqrt(d2) : 0.0f;
-    float3 wi = d2 > 0.0f ? to_p * inv_d : (float3)(0.0f, 0.0f, 1.0f); /* light → p */
+    float4 d2_clamped = max(d2, r2);
+    int4 apart = d2 > zero;
+    float4 inv_d = select(zero, one / sqrt(d2), apart);
+    float4 wx = dx * inv_d, wy = dy * inv_d, wz = select(one, dz * inv_d, apart); /* light → p */
 
     /* θ_w: between the cone's axis and the direction to p; either way for two-sided lights. */
-    float cos_w = dot(node->axis.xyz, wi);
-    if ((node->flags & LIGHT_NODE_TWO_SIDED) != 0u) cos_w = fabs(cos_w);
-    float sin_w = safe_sqrt1m(cos_w);
+    float4 cos_w = node->ax * wx + node->ay * wy + node->az * wz;
+    int4 two_sided = ((uint4)(node->flags) & (uint4)(LIGHT_SLOT_TWO_SIDED, LIGHT_SLOT_TWO_SIDED << 1,
+                                                     LIGHT_SLOT_TWO_SIDED << 2,
+                                                     LIGHT_SLOT_TWO_SIDED << 3)) != (uint4)(0u);
+    cos_w = select(cos_w, fabs(cos_w), two_sided);
+    float4 sin_w = sqrt(max(zero, one - cos_w * cos_w));
     /* θ_b: half-angle of the bounding sphere seen from p; the whole sphere from inside it. */
-    float sin_b = d2 > r2 ? min(r * inv_d, 1.0f) : 1.0f;
-    float cos_b = d2 > r2 ? safe_sqrt1m(sin_b) : -1.0f;
+    int4 outside = d2 > r2;
+    float4 sin_b = select(one, min(r * inv_d, one), outside);
+    float4 cos_b = select(-one, sqrt(max(zero, one - sin_b * sin_b)), outside);
     /* θ' = max(0, θ_w − θ_o − θ_b): the least angle between a normal and a direction to p. */
-    float cos_o = node->hi.w, sin_o = node->sin_o;
-    float cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, cos_o);
-    float sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, cos_o);
-    float cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
-    if (cos_p <= node->axis.w) return 0.0f;
+    float4 cos_o = node->cos_o, sin_o = node->sin_o;
+    int4 in_cone = cos_w > cos_o;
+    float4 cos_x = select(cos_w * cos_o + sin_w * sin_o, one, in_cone);
+    float4 sin_x = select(sin_w * cos_o - cos_w * sin_o, zero, in_cone);
+    float4 cos_p = select(cos_x * cos_b + sin_x * sin_b, one, cos_x > cos_b);
 
-    /* At the receiver: the least angle between n and a direction toward the box. */
-    float cos_i = -dot(n, wi);
-    float sin_i = safe_sqrt1m(cos_i);
-    float cos_pi = cos_sub_clamped(sin_i, cos_i, sin_b, cos_b);
-    if (cos_pi <= 0.0f) return 0.0f;
-    return node->lo.w * cos_p / d2_clamped * cos_pi;
+    /* At the receiver: the least angle between n and a direction toward the sphere. */
+    float4 cos_i = -(n.x * wx + n.y * wy + n.z * wz);
+    float4 sin_i = sqrt(max(zero, one - cos_i * cos_i));
+    float4 cos_pi = select(cos_i * cos_b + sin_i * sin_b, one, cos_i > cos_b);
+    float4 importance = node->phi * cos_p * cos_pi / d2_clamped;
+    return select(importance, zero, (cos_p <= node->cos_e) | (cos_pi <= zero));
 }
 
-/* Probabilities of the first (*first) and second (*second) child, a and b, of an inner node at
- * (p, n): the one computation the sampler and the pmf share, so that both multiply the very
- * same floats. The children's bounds are tighter than the parent's, so both may have no
- * importance where the parent had some: they are then weighed by power alone (neither can
- * light p, so the choice only needs to be some choice), and the pmfs of all lights sum to 1
- * wherever the root has importance. False only for a non-finite importance. */
-inline bool light_tree_split(global const LightTreeNode* a, global const LightTreeNode* b, float3 p,
-                             float3 n, float* first, float* second) {
-    float ia = light_node_importance(a, p, n), ib = light_node_importance(b, p, n);
-    if (ia == 0.0f && ib == 0.0f) {
-        ia = a->lo.w;
-        ib = b->lo.w;
+/* The probabilities of a node's four slots at (p, n): the one computation the sampler and the
+ * pmf share, so that both multiply the very same floats. A slot's bounds are tighter than its
+ * parent's, so all four may have no importance where the parent had some: they are then weighed
+ * by power alone (none can light p, so the choice only needs to be some choice), and the pmfs of
+ * all lights sum to 1 wherever the root's slots have importance. False at the root when no
+ * light can reach p, and anywhere for a non-finite importance. */
+inline bool light_tree_shares(global const LightTreeNode* node, float3 p, float3 n, bool root,
+                              float4* share) {
+    float4 importance = light_slot_importance(node, p, n);
+    float sum = (importance.x + importance.y) + (importance.z + importance.w);
+    if (sum == 0.0f && !root) {
+        importance = node->phi;
+        sum = (importance.x + importance.y) + (importance.z + importance.w);
     }
-    float sum = ia + ib;
     if (!(sum > 0.0f) || !isfinite(sum)) return false;
-    *first = ia / sum;
-    *second = ib / sum;
+    *share = importance / sum;
     return true;
+}
+
+inline float light_slot_share(float4 share, uint slot) {
+    return slot == 0u ? share.x : slot == 1u ? share.y : slot == 2u ? share.z : share.w;
+}
+
+/* Where [lo, hi) is cut between a part of share a (below) and one of share b (above), both
+ * taken of the node's span: the smaller share's width is computed directly, so that both keep
+ * their relative precision, and a part with a share keeps at least one value. */
+inline ulong light_tree_cut(ulong lo, ulong hi, float a, float b, float span) {
+    ulong width = hi - lo;
+    /* Through signed 64-bit conversions (span ≤ 2^62): the hardware's, where unsigned ones may
+     * be emulated. */
+    ulong t = a <= b ? min(width, (ulong)(long)(a * span))
+                     : width - min(width, (ulong)(long)(b * span));
+    if (a > 0.0f) t = max(t, min(width, 1ul));
+    if (b > 0.0f && width > 0ul) t = min(t, width - 1ul);
+    return lo + t;
 }
 
 /* Chooses a light at (p, n) from u on the 2^-24 grid refined by u_fine (discrete.cl). The
  * number (k + u_fine)·2^-24 is held as a 62-bit integer x in [0, range), range ≤ 2^62; each
- * level cuts the range at the first child's share t (the smaller share computed directly, so
- * that both keep their relative precision) and keeps the part x falls in, rescaled: the
- * stratification of u carries over as with CDF inversion, and x / range at the leaf is uniform for
- * the point on the light. pmf is the product of the children's probabilities: the chance of the
- * choice up to float rounding. pmf 0: no light can reach p (index is then meaningless). */
+ * level cuts the range into the slots' shares (first the two pairs, then within each pair) and
+ * keeps the part x falls in, rescaled: the stratification of u carries over as with CDF
+ * inversion, and x / range at the leaf is uniform for the point on the light. pmf is the product
+ * of the slots' probabilities: the chance of the choice up to float rounding. pmf 0: no light
+ * can reach p (index is then meaningless). */
 inline DiscreteSample sample_light_tree(global const LightTreeNode* nodes, float3 p, float3 n,
                                         float u, float u_fine) {
     DiscreteSample s;
@@ -93,57 +106,55 @@ inline DiscreteSample sample_light_tree(global const LightTreeNode* nodes, float
     s.pmf = 0.0f;
     s.u_remap = 0.0f;
     global const LightTreeNode* node = nodes;
-    /* No importance at the root: no light can reach p (or the tree is empty). */
-    if (!(light_node_importance(node, p, n) > 0.0f)) return s;
     ulong x = ((ulong)unit_to_grid(u) << 38) + (ulong)(long)(u_fine * 0x1.0p38f);
     ulong range = 1ul << 62;
     float pmf = 1.0f;
-    while ((node->flags & LIGHT_NODE_LEAF) == 0u) {
-        global const LightTreeNode* a = nodes + node->child;
-        float first, second;
-        if (!light_tree_split(a, a + 1, p, n, &first, &second)) return s;
-        /* Through signed 64-bit conversions (range ≤ 2^62): the hardware's, where unsigned
-         * ones may be emulated. */
+    for (uint depth = 0u; depth < MCRT_LIGHT_TREE_MAX_DEPTH; ++depth) {
+        float4 share;
+        if (!light_tree_shares(node, p, n, depth == 0u, &share)) return s;
         float span = (float)(long)range;
-        ulong t = first <= second ? (ulong)(long)(first * span)
-                                  : range - min(range, (ulong)(long)(second * span));
-        /* Each child with a share keeps at least one value of x. */
-        if (first > 0.0f) t = max(t, 1ul);
-        if (second > 0.0f) t = min(t, range - 1ul);
-        uint which = x < t ? 0u : 1u;
-        if (which == 0u) {
-            range = t;
-            pmf *= first;
+        ulong middle = light_tree_cut(0ul, range, share.x + share.y, share.z + share.w, span);
+        ulong lo, hi;
+        uint slot;
+        if (x < middle) {
+            ulong cut = light_tree_cut(0ul, middle, share.x, share.y, span);
+            slot = x < cut ? 0u : 1u;
+            lo = x < cut ? 0ul : cut;
+            hi = x < cut ? cut : middle;
         } else {
-            x -= t;
-            range -= t;
-            pmf *= second;
+            ulong cut = light_tree_cut(middle, range, share.z, share.w, span);
+            slot = x < cut ? 2u : 3u;
+            lo = x < cut ? middle : cut;
+            hi = x < cut ? cut : range;
         }
-        node = a + which;
+        x -= lo;
+        range = hi - lo;
+        pmf *= light_slot_share(share, slot);
+        if ((node->flags & (LIGHT_SLOT_LEAF << slot)) != 0u) {
+            s.index = node->child[slot];
+            s.pmf = pmf;
+            s.u_remap = min((float)(long)x / (float)(long)range, 0x1.fffffep-1f);
+            return s;
+        }
+        node = nodes + node->child[slot];
     }
-    s.index = node->child;
-    s.pmf = pmf;
-    s.u_remap = min((float)(long)x / (float)(long)range, 0x1.fffffep-1f);
-    return s;
+    return s; /* deeper than any tree the host builds */
 }
 
-/* Probability that sample_light_tree at (p, n) returns the light whose trail is `trail` and
- * path length depth_plus_one − 1 (LightTreePath): the same products along its path. */
-inline float light_tree_pmf(global const LightTreeNode* nodes, uint trail, uint depth_plus_one,
-                            float3 p, float3 n) {
-    if (depth_plus_one == 0u) return 0.0f;
+/* Probability that sample_light_tree at (p, n) returns the light whose path is `trail` over
+ * `length` nodes (LightTreePath): the same products along its path. */
+inline float light_tree_pmf(global const LightTreeNode* nodes, uint trail, uint length, float3 p,
+                            float3 n) {
     global const LightTreeNode* node = nodes;
-    if (!(light_node_importance(node, p, n) > 0.0f)) return 0.0f;
     float pmf = 1.0f;
-    for (uint d = 0u; d + 1u < depth_plus_one; ++d) {
-        global const LightTreeNode* a = nodes + node->child;
-        float first, second;
-        if (!light_tree_split(a, a + 1, p, n, &first, &second)) return 0.0f;
-        uint which = (trail >> d) & 1u;
-        pmf *= which == 0u ? first : second;
-        node = a + which;
+    for (uint depth = 0u; depth < length; ++depth) {
+        float4 share;
+        if (!light_tree_shares(node, p, n, depth == 0u, &share)) return 0.0f;
+        uint slot = (trail >> (2u * depth)) & 3u;
+        pmf *= light_slot_share(share, slot);
+        if (depth + 1u < length) node = nodes + node->child[slot];
     }
-    return pmf;
+    return length == 0u ? 0.0f : pmf;
 }
 
 #endif

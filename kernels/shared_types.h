@@ -171,34 +171,42 @@ typedef struct {
     uint surface;      /* its triangle's packet lane (TriangleSurface, TriangleInfo) */
 } Light;
 
-/* Node of the light tree (host/render/light_tree.h), 64 bytes: the bounds of the lights below it
- * for the importance of kernels/light_tree.cl (Conty Estevez & Kulla 2018; pbrt-v4's
- * LightBounds). Children of an inner node are adjacent: nodes[child], nodes[child + 1]; a leaf
- * holds one light. nodes[0] is the root.
- * lo.xyz / hi.xyz: box of the lights' vertices; lo.w: power φ (0 only in an empty tree).
- * axis.xyz: unit axis w of the cone of emitting normals; hi.w: cos θ_o, its half-angle;
- * axis.w: cos θ_e, how far beyond the normals a light emits (π/2 for area lights: 0). */
+/* Node of the light tree (host/render/light_tree.h), 208 bytes: four slots, each a child node
+ * or one light, with the bounds of the lights below it for the importance of
+ * kernels/light_tree.cl (Conty Estevez & Kulla 2018; pbrt-v4's LightBounds), laid out as one
+ * float4 per quantity so that the four importances are one vector computation. nodes[0] is the
+ * root. Per slot k (the vectors' component k):
+ * x, y, z: centre of the box of the lights' vertices; radius: of the box's bounding sphere about
+ * it, rounded up. ax, ay, az: unit axis w of the cone of emitting normals; cos_o: cos θ_o, its
+ * half-angle, rounded down, sin_o its sine rounded up; cos_e: cos θ_e, how far beyond the normals
+ * a light emits (π/2 for area lights: 0), rounded down. phi: power φ, 0 for an empty slot.
+ * child[k]: the child node's index, or the light's where bit k of flags is set
+ * (LIGHT_SLOT_LEAF << k); LIGHT_SLOT_TWO_SIDED << k: some light below emits both ways. */
 typedef struct {
-    float4 lo;
-    float4 hi;
-    float4 axis;
-    uint child;    /* inner: index of the first child; leaf: index of its Light */
-    uint flags;    /* LIGHT_NODE_LEAF, LIGHT_NODE_TWO_SIDED (some light below emits both ways) */
-    float radius;  /* of the box's bounding sphere about its centre, |hi − lo|/2 rounded up */
-    float sin_o;   /* sin θ_o, rounded up: what the traversal would otherwise take a root of */
+    float4 x, y, z;
+    float4 radius;
+    float4 ax, ay, az;
+    float4 cos_o;
+    float4 sin_o;
+    float4 cos_e;
+    float4 phi;
+    uint child[4];
+    uint flags;
+    uint pad0, pad1, pad2;
 } LightTreeNode;
 
-#define LIGHT_NODE_LEAF 1u
-#define LIGHT_NODE_TWO_SIDED 2u
+#define LIGHT_TREE_WIDTH 4
+#define LIGHT_SLOT_LEAF 1u        /* << slot */
+#define LIGHT_SLOT_TWO_SIDED 16u  /* << slot */
 
-/* Longest root-to-leaf path of the light tree, in edges: a light's path is a bit trail of at
- * most this many bits (LightTreePath), the builder switching to median splits before a path
+/* Longest root-to-leaf path of the light tree, in levels of nodes: a light's path is a trail of
+ * two bits per level (LightTreePath), the builder switching to median splits before a path
  * could grow longer. */
-#define MCRT_LIGHT_TREE_MAX_DEPTH 32
+#define MCRT_LIGHT_TREE_MAX_DEPTH 16
 
-/* A light's path from the light tree's root to its leaf, 8 bytes, one per light after the
- * tree's nodes in the tree's buffer: bit d of `bits` set where the path goes to the second
- * child at depth d; `length` 1 + its number of edges, 0 for a light not in the tree (no power).
+/* A light's path from the light tree's root to its slot, 8 bytes, one per light after the
+ * tree's nodes in the tree's buffer: bits 2d, 2d + 1 of `bits` the slot taken at depth d;
+ * `length` its number of nodes, 0 for a light not in the tree (no power).
  * The twins of the tree's choice (light_tree_pmf) walk it. */
 typedef struct {
     uint bits;
@@ -398,10 +406,12 @@ enum RenderArgument {
     TYPE(LightTreePath, 8, 4) FIELD(LightTreePath, bits, 0) FIELD(LightTreePath, length, 4)     \
     TYPE(AliasEntry, 16, 4) FIELD(AliasEntry, threshold, 0) FIELD(AliasEntry, alias, 4)         \
     FIELD(AliasEntry, pmf, 8)                                                                   \
-    TYPE(LightTreeNode, 64, 16) FIELD(LightTreeNode, lo, 0) FIELD(LightTreeNode, hi, 16)       \
-    FIELD(LightTreeNode, axis, 32) FIELD(LightTreeNode, child, 48)                              \
-    FIELD(LightTreeNode, flags, 52) FIELD(LightTreeNode, radius, 56)                            \
-    FIELD(LightTreeNode, sin_o, 60)                                                             \
+    TYPE(LightTreeNode, 208, 16) FIELD(LightTreeNode, x, 0) FIELD(LightTreeNode, y, 16)       \
+    FIELD(LightTreeNode, z, 32) FIELD(LightTreeNode, radius, 48) FIELD(LightTreeNode, ax, 64)   \
+    FIELD(LightTreeNode, ay, 80) FIELD(LightTreeNode, az, 96) FIELD(LightTreeNode, cos_o, 112)  \
+    FIELD(LightTreeNode, sin_o, 128) FIELD(LightTreeNode, cos_e, 144)                           \
+    FIELD(LightTreeNode, phi, 160) FIELD(LightTreeNode, child, 176)                             \
+    FIELD(LightTreeNode, flags, 192)                                                            \
     TYPE(CameraGpu, 64, 16) FIELD(CameraGpu, eye, 0) FIELD(CameraGpu, right, 16)                \
     FIELD(CameraGpu, up, 32) FIELD(CameraGpu, forward, 48)                                      \
     TYPE(RenderParams, 80, 16) FIELD(RenderParams, sky, 0) FIELD(RenderParams, ao_distance, 16) \

@@ -905,56 +905,87 @@ struct TreeCase {
 };
 const std::vector<TreeCase> kTreeCases = {{1, 0}, {2, 0}, {5, 1}, {64, 3}, {1000, 10}, {0, 0}};
 
-TEST_CASE("light tree: every light in one leaf, bounds hold their children", "[sampling][light-tree]") {
+TEST_CASE("light tree: every light in one slot, bounds hold what is below them", "[sampling][light-tree]") {
     for (const TreeCase& c : kTreeCases) {
         INFO("lights " << c.n);
         TreeLights t = tree_lights(c.n, 7u + uint32_t(c.n), c.zero_power);
         LightTree tree = build_light_tree(t.lights, t.powers);
         const size_t in_tree = t.lights.size() - size_t(c.zero_power);
-        REQUIRE(tree.nodes.size() == 2 * in_tree - 1);
+        REQUIRE(!tree.nodes.empty());
+        CHECK(tree.nodes.size() <= std::max<size_t>(1, in_tree - 1));
         std::vector<int> leaf_of(t.lights.size(), 0);
-        size_t max_depth = 0;
+        size_t max_length = 0;
         for (size_t i = 0; i < t.lights.size(); ++i) {
             if (t.powers[i] == 0) {
                 CHECK(tree.paths[i].length == 0);
                 continue;
             }
-            REQUIRE(tree.paths[i].length >= 1);
-            const size_t depth = tree.paths[i].length - 1;
-            max_depth = std::max(max_depth, depth);
-            REQUIRE(depth <= MCRT_LIGHT_TREE_MAX_DEPTH);
-            // Down the trail: every node on it bounds the light (box, normal cone, power).
+            const size_t length = tree.paths[i].length;
+            REQUIRE(length >= 1);
+            REQUIRE(length <= MCRT_LIGHT_TREE_MAX_DEPTH);
+            max_length = std::max(max_length, length);
+            // Down the trail: every slot on it bounds the light (sphere, normal cone, power).
             const gpu::Light& l = t.lights[i];
             dvec3 p0 = d3(l.p0), p1 = d3(l.p1), p2 = d3(l.p2);
             dvec3 normal = glm::normalize(glm::cross(p1 - p0, p2 - p0));
             uint32_t node = 0;
-            for (size_t d = 0; d <= depth; ++d) {
+            for (size_t d = 0; d < length; ++d) {
+                REQUIRE(node < tree.nodes.size());
                 const gpu::LightTreeNode& x = tree.nodes[node];
-                for (const dvec3& v : {p0, p1, p2})
-                    for (int a = 0; a < 3; ++a) {
-                        CHECK(v[a] >= (&x.lo.x)[a]);
-                        CHECK(v[a] <= (&x.hi.x)[a]);
-                    }
-                dvec3 axis(x.axis.x, x.axis.y, x.axis.z);
-                CHECK(glm::dot(axis, normal) >= double(x.hi.w) - 1e-6);
-                CHECK(double(x.lo.w) >= 0.999 * t.powers[i]);
-                if (d == depth) {
-                    CHECK((x.flags & LIGHT_NODE_LEAF) != 0);
-                    CHECK(x.child == i);
+                const int k = int((tree.paths[i].bits >> (2 * d)) & 3u);
+                auto at = [k](const gpu::float4& v) { return double((&v.x)[k]); };
+                const dvec3 centre(at(x.x), at(x.y), at(x.z));
+                for (const dvec3& v : {p0, p1, p2}) CHECK(glm::length(v - centre) <= at(x.radius));
+                dvec3 axis(at(x.ax), at(x.ay), at(x.az));
+                CHECK(glm::dot(axis, normal) >= at(x.cos_o) - 1e-6);
+                CHECK(at(x.sin_o) >= std::sqrt(std::max(0.0, 1 - at(x.cos_o) * at(x.cos_o))));
+                CHECK(at(x.cos_e) <= 0.0);
+                CHECK(at(x.phi) >= 0.999 * t.powers[i]);
+                if ((l.flags & MATERIAL_DOUBLE_SIDED) != 0)
+                    CHECK((x.flags & (LIGHT_SLOT_TWO_SIDED << k)) != 0);
+                if (d + 1 == length) {
+                    CHECK((x.flags & (LIGHT_SLOT_LEAF << k)) != 0);
+                    CHECK(x.child[k] == i);
                     leaf_of[i] += 1;
                 } else {
-                    REQUIRE((x.flags & LIGHT_NODE_LEAF) == 0);
-                    node = x.child + ((tree.paths[i].bits >> d) & 1u);
+                    REQUIRE((x.flags & (LIGHT_SLOT_LEAF << k)) == 0);
+                    node = x.child[k];
                 }
             }
         }
         for (size_t i = 0; i < t.lights.size(); ++i) CHECK(leaf_of[i] == (t.powers[i] > 0 ? 1 : 0));
-        // The root's power is the sum of all.
-        CHECK(double(tree.nodes[0].lo.w) ==
+        // Every slot: a light, a node or empty (no power); as many light slots as lights.
+        size_t light_slots = 0;
+        for (const gpu::LightTreeNode& x : tree.nodes)
+            for (int k = 0; k < 4; ++k) {
+                if ((x.flags & (LIGHT_SLOT_LEAF << k)) != 0) ++light_slots;
+                if ((&x.phi.x)[k] == 0.0f) CHECK((&x.cos_e.x)[k] == 1.0f);
+            }
+        CHECK(light_slots == in_tree);
+        // The root's slots hold the power of all.
+        const gpu::float4& phi = tree.nodes[0].phi;
+        CHECK(double(phi.x) + phi.y + phi.z + phi.w ==
               Approx(std::accumulate(t.powers.begin(), t.powers.end(), 0.0)).epsilon(1e-5));
-        if (c.n == 0) CHECK(max_depth <= MCRT_LIGHT_TREE_MAX_DEPTH);  // the chain hit the limit
-        std::printf("light tree of %zu lights: %zu nodes, depth %zu\n", in_tree, tree.nodes.size(),
-                    max_depth);
+        if (c.n == 0) CHECK(max_length <= MCRT_LIGHT_TREE_MAX_DEPTH);  // the chain stays within it
+        std::printf("light tree of %zu lights: %zu nodes, longest path %zu nodes\n", in_tree,
+                    tree.nodes.size(), max_length);
+    }
+}
+
+TEST_CASE("light tree: the parallel build gives the same tree whatever the number of threads",
+          "[sampling][light-tree]") {
+    // Enough lights that subtrees are built on threads of their own (kParallelGrain).
+    TreeLights t = tree_lights(60000, 23u, 100);
+    LightTree one = build_light_tree(t.lights, t.powers, 1);
+    for (int threads : {2, 3, 8}) {
+        INFO("threads " << threads);
+        LightTree many = build_light_tree(t.lights, t.powers, threads);
+        REQUIRE(many.nodes.size() == one.nodes.size());
+        CHECK(std::memcmp(many.nodes.data(), one.nodes.data(),
+                          one.nodes.size() * sizeof(gpu::LightTreeNode)) == 0);
+        REQUIRE(many.paths.size() == one.paths.size());
+        CHECK(std::memcmp(many.paths.data(), one.paths.data(),
+                          one.paths.size() * sizeof(gpu::LightTreePath)) == 0);
     }
 }
 

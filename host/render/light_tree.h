@@ -13,19 +13,21 @@ namespace mcrt {
 
 struct LightTree {
     std::vector<gpu::LightTreeNode> nodes;  // nodes[0] the root; empty when no light has power
-    // Per light: its path from the root (bit d set: second child at depth d) and the path's
-    // length plus one, 0 for a light outside the tree (zero power): what the kernels' pmf twin
-    // walks, uploaded after the nodes.
+    // Per light: its path from the root (bits 2d, 2d + 1: the slot taken at depth d) and the
+    // path's number of nodes, 0 for a light outside the tree (zero power): what the kernels'
+    // pmf twin walks, uploaded after the nodes.
     std::vector<gpu::LightTreePath> paths;
 };
 
 // Builds the tree over `lights` (vertices and MATERIAL_DOUBLE_SIDED from gpu::Light) weighted by
-// `powers` (one per light, >= 0; zero-power lights are left out and never chosen). Top-down,
-// binned (12 buckets per axis) with pbrt-v4's surface-area-orientation cost: power × the
-// orientation measure M_Ω of the cone × surface area × the box's aspect penalty. Leaves hold
-// one light; no path is longer than MCRT_LIGHT_TREE_MAX_DEPTH.
+// `powers` (one per light, >= 0; zero-power lights are left out and never chosen). A binary
+// tree top-down, binned (12 buckets per axis) with pbrt-v4's surface-area-orientation cost:
+// power × the orientation measure M_Ω of the cone × surface area × the box's aspect penalty,
+// its subtrees built on `threads` threads (0: one per core; the tree is the same for any
+// number); then collapsed two levels to a node of four slots, a slot holding one light or a
+// node. No path is longer than MCRT_LIGHT_TREE_MAX_DEPTH nodes.
 LightTree build_light_tree(const std::vector<gpu::Light>& lights,
-                           const std::vector<double>& powers);
+                           const std::vector<double>& powers, int threads = 0);
 
 // The tree as the kernels read it from the selection's buffer: its nodes (at least one), then
 // one path per light (RENDER_ARG_LIGHT_SELECTION), as 32-bit words.
