@@ -24,7 +24,7 @@ inline float4 light_slot_importance(global const LightTreeNode* node, float3 p, 
      * the box does not get an unbounded importance. pbrt-v4 writes max(d², |diagonal|/2),
      * comparing a squared distance with a length (its scale-dependent slip); this compares
      * squares. */
-    float4 d2_clamped = max(d2, r2);
+    float4 inv_d2_clamped = one / max(d2, r2); /* off the chain of dependent operations below */
     int4 apart = d2 > zero;
     float4 inv_d = select(zero, one / sqrt(d2), apart);
     float4 wx = dx * inv_d, wy = dy * inv_d, wz = select(one, dz * inv_d, apart); /* light → p */
@@ -51,7 +51,7 @@ inline float4 light_slot_importance(global const LightTreeNode* node, float3 p, 
     float4 cos_i = -(n.x * wx + n.y * wy + n.z * wz);
     float4 sin_i = sqrt(max(zero, one - cos_i * cos_i));
     float4 cos_pi = select(cos_i * cos_b + sin_i * sin_b, one, cos_i > cos_b);
-    float4 importance = node->phi * cos_p * cos_pi / d2_clamped;
+    float4 importance = node->phi * inv_d2_clamped * cos_p * cos_pi;
     return select(importance, zero, (cos_p <= node->cos_e) | (cos_pi <= zero));
 }
 
@@ -114,19 +114,15 @@ inline DiscreteSample sample_light_tree(global const LightTreeNode* nodes, float
         if (!light_tree_shares(node, p, n, depth == 0u, &share)) return s;
         float span = (float)(long)range;
         ulong middle = light_tree_cut(0ul, range, share.x + share.y, share.z + share.w, span);
-        ulong lo, hi;
-        uint slot;
-        if (x < middle) {
-            ulong cut = light_tree_cut(0ul, middle, share.x, share.y, span);
-            slot = x < cut ? 0u : 1u;
-            lo = x < cut ? 0ul : cut;
-            hi = x < cut ? cut : middle;
-        } else {
-            ulong cut = light_tree_cut(middle, range, share.z, share.w, span);
-            slot = x < cut ? 2u : 3u;
-            lo = x < cut ? middle : cut;
-            hi = x < cut ? cut : range;
-        }
+        /* Both pairs' cuts, then the one x needs: no branch between dependent steps. */
+        ulong left = light_tree_cut(0ul, middle, share.x, share.y, span);
+        ulong right = light_tree_cut(middle, range, share.z, share.w, span);
+        bool first_pair = x < middle;
+        ulong cut = first_pair ? left : right;
+        bool below = x < cut;
+        uint slot = (first_pair ? 0u : 2u) + (below ? 0u : 1u);
+        ulong lo = below ? (first_pair ? 0ul : middle) : cut;
+        ulong hi = below ? cut : (first_pair ? middle : range);
         x -= lo;
         range = hi - lo;
         pmf *= light_slot_share(share, slot);

@@ -6,6 +6,10 @@
   over 9, so powers span more than 10^4; 30% face up, away from the floor, and those are the
   brightest (x10), so selection by power spends most samples on lights that cannot light the
   floor. The camera, below the lamps, sees only the floor.
+- lamp-grid: 576 small triangle lights on a 24 x 24 grid 0.5 apart, 1 above a floor, each
+  tilted up to 45 degrees, a third of them (at random) facing up, away from the floor;
+  radiances log-spaced over 10^4 in a random order over the grid, so power does not follow
+  position or orientation. Compact: the field spreads 12 wide against the lamps' height of 1.
 - emissive-bunny: the Stanford bunny (69 451 triangles, every one an emitter, front faces out)
   standing on a floor, scaled to 1.2 high; from a floor point only the faces turned toward it
   count, and the nearest of them most.
@@ -66,6 +70,36 @@ def lamp_field():
     return g.finish()
 
 
+def lamp_grid():
+    g = StressScene("lamp-grid")
+    g.triangles("floor", quad((0.0, 0.0, 0.0), scale(Z, 16.0), scale(X, 16.0)),
+                g.lambertian("floor", (0.6, 0.6, 0.6)))
+    rng = random.Random(29)
+    levels = 9
+    groups = {}
+    for i in range(24):
+        for j in range(24):
+            c = (-5.75 + 0.5 * i, 1.0, -5.75 + 0.5 * j)
+            up = rng.random() < 1.0 / 3.0
+            level = rng.randrange(levels)
+            theta, phi = math.radians(45.0) * math.sqrt(rng.random()), 2.0 * math.pi * rng.random()
+            n = (math.sin(theta) * math.cos(phi), -math.cos(theta), math.sin(theta) * math.sin(phi))
+            if up:
+                n = scale(n, -1.0)
+            a = normalize(cross(n, (1.0, 0.0, 0.0) if abs(n[0]) < 0.9 else (0.0, 0.0, 1.0)))
+            b = cross(n, a)
+            size = 0.12
+            groups.setdefault(level, []).extend([c, add(c, scale(a, size)), add(c, scale(b, size))])
+    parts = []
+    for level, points in sorted(groups.items()):
+        L = 10.0 ** (4.0 * level / (levels - 1))
+        parts.append((points, g.emitter("lamp %d" % level, (L, 0.85 * L, 0.7 * L))))
+    g.triangle_set("lamps", parts)
+    # Below the lamps, looking down over the floor: no ray rises, none sees a lamp.
+    g.camera((0.0, 0.8, 4.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), 40.0)
+    return g.finish()
+
+
 def read_glb_mesh(path):
     """Positions and triangle indices of the first primitive of a .glb (float VEC3, any uint)."""
     data = path.read_bytes()
@@ -106,7 +140,7 @@ def emissive_bunny():
     return g.finish()
 
 
-SCENES = {"lamp-field": lamp_field, "emissive-bunny": emissive_bunny}
+SCENES = {"lamp-field": lamp_field, "lamp-grid": lamp_grid, "emissive-bunny": emissive_bunny}
 
 
 def main():
