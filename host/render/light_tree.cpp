@@ -189,45 +189,60 @@ struct BinaryBuilder {
     std::vector<BinaryNode>& nodes;
     std::atomic<int> free_threads;
 
-    // `given`: the bounds of order[begin, end) where the parent's split already has them.
-    void build(size_t begin, size_t end, uint32_t index, int depth, const Bounds* given) {
-        BinaryNode& node = nodes[index];
-        Bounds centroids;
-        if (given != nullptr) node.bounds = *given;
-        for (size_t i = begin; i < end; ++i) {
-            if (given == nullptr) node.bounds.add(items[order[i]]);
-            centroids.lo = glm::min(centroids.lo, centroid[order[i]]);
-            centroids.hi = glm::max(centroids.hi, centroid[order[i]]);
+    // What the parent's split found out about the lights of a child: their bounds and the box
+    // of their centroids.
+    struct Side {
+        Bounds bounds;
+        Bounds centroids;  // lo, hi only
+
+        void add(const Bounds& item, const glm::dvec3& c) {
+            bounds.add(item);
+            centroids.lo = glm::min(centroids.lo, c);
+            centroids.hi = glm::max(centroids.hi, c);
         }
+    };
+
+    // `given`: what is known of order[begin, end), nullptr at the root.
+    void build(size_t begin, size_t end, uint32_t index, int depth, const Side* given) {
+        BinaryNode& node = nodes[index];
+        Side all;
+        if (given != nullptr) {
+            all = *given;
+        } else {
+            for (size_t i = begin; i < end; ++i) all.add(items[order[i]], centroid[order[i]]);
+        }
+        node.bounds = all.bounds;
         if (end - begin == 1) {
             node.leaf = true;
             node.light = order[begin];
             return;
         }
-        Bounds halves[2];
-        bool binned = false;
-        const size_t mid = split(begin, end, node.bounds, centroids, depth, halves, &binned);
+        Side halves[2];
+        const size_t mid = split(begin, end, all.bounds, all.centroids, depth, halves);
         node.left = index + 1;
         node.right = index + uint32_t(2 * (mid - begin));
         const uint32_t left = node.left, right = node.right;
-        // The sweep's halves are exact; the bins' estimated, so their nodes take their own.
-        const Bounds* first_bounds = binned ? &halves[0] : nullptr;
-        const Bounds* second_bounds = binned ? &halves[1] : nullptr;
         if (mid - begin > kParallelGrain && end - mid > kParallelGrain && take_thread()) {
-            std::thread first([=] { build(begin, mid, left, depth + 1, first_bounds); });
-            build(mid, end, right, depth + 1, second_bounds);
+            std::thread first([=, &halves] { build(begin, mid, left, depth + 1, &halves[0]); });
+            build(mid, end, right, depth + 1, &halves[1]);
             first.join();
             free_threads += 1;
         } else {
-            build(begin, mid, left, depth + 1, first_bounds);
-            build(mid, end, right, depth + 1, second_bounds);
+            build(begin, mid, left, depth + 1, &halves[0]);
+            build(mid, end, right, depth + 1, &halves[1]);
         }
+    }
+
+    // The two sides of a cut at mid, in one pass.
+    void sides(size_t begin, size_t mid, size_t end, Side* halves) const {
+        for (size_t i = begin; i < end; ++i)
+            halves[i < mid ? 0 : 1].add(items[order[i]], centroid[order[i]]);
     }
 
     // The split of few lights: every cut between them in centroid order on each axis, the
     // SAOH of each from running unions from both ends (the exact sweep the bins approximate).
     size_t sweep(size_t begin, size_t end, const glm::dvec3& diagonal, const glm::dvec3& extent,
-                 Bounds* halves, bool* binned) {
+                 Side* halves) {
         const size_t n = end - begin;
         const double max_extent = std::max({diagonal.x, diagonal.y, diagonal.z});
         double best_cost = std::numeric_limits<double>::infinity();
@@ -255,17 +270,14 @@ struct BinaryBuilder {
                 if (cost < best_cost) {
                     best_cost = cost;
                     best_cut = i + 1;
-                    halves[0] = below[i];
-                    halves[1] = above;
                     std::copy(sorted, sorted + n, best_order);
                 }
             }
         }
-        if (best_cut == 0) {  // every centroid at one point: cut the middle of the order
-            return begin + n / 2;
-        }
-        std::copy(best_order, best_order + n, order.begin() + long(begin));
-        *binned = true;
+        // Every centroid at one point: cut the middle of the order.
+        if (best_cut == 0) best_cut = n / 2;
+        else std::copy(best_order, best_order + n, order.begin() + long(begin));
+        sides(begin, begin + best_cut, end, halves);
         return begin + best_cut;
     }
 
@@ -276,13 +288,16 @@ struct BinaryBuilder {
         return false;
     }
 
-    // Where order[begin, end) is cut: the binned SAOH's best bucket boundary, the sweep's best
-    // cut for few lights (*binned, with the two sides' bounds in halves), or the median of the widest centroid axis when no bucket
+    // Where order[begin, end) is cut, with what is known of both sides in halves: the binned
+    // SAOH's best bucket boundary, the sweep's best cut for few lights, or the median of the widest centroid axis when no bucket
     // split exists or the path would grow too long. The three axes are binned in one pass.
     size_t split(size_t begin, size_t end, const Bounds& all, const Bounds& centroids, int depth,
-                 Bounds* halves, bool* binned) {
+                 Side* halves) {
         const size_t n = end - begin;
-        if (n == 2) return begin + 1;  // the one split there is
+        if (n == 2) {  // the one split there is
+            sides(begin, begin + 1, end, halves);
+            return begin + 1;
+        }
         // Up to four lights all become slots of one node however they are split (Collapser):
         // the split only pairs them for the node's first cut, and the median pairs neighbours.
         const bool balance = n <= 4 || depth + ceil_log2(n) >= kMaxBinaryDepth;
@@ -295,7 +310,7 @@ struct BinaryBuilder {
             double t = (centroid[item][dim] - centroids.lo[dim]) * scale[dim];
             return std::clamp(int(t), 0, kBuckets - 1);
         };
-        if (!balance && n <= kSweepMax) return sweep(begin, end, diagonal, extent, halves, binned);
+        if (!balance && n <= kSweepMax) return sweep(begin, end, diagonal, extent, halves);
         if (!balance) {
             Bounds bucket[3][kBuckets];
             size_t count[3][kBuckets] = {};
@@ -337,11 +352,25 @@ struct BinaryBuilder {
             }
         }
         if (best_dim >= 0) {
-            auto it = std::partition(
-                order.begin() + long(begin), order.begin() + long(end),
-                [&](uint32_t item) { return bucket_of(item, best_dim) <= best_bucket; });
-            size_t mid = size_t(it - order.begin());
-            if (mid > begin && mid < end) return mid;
+            // Partitioned in place, each light's side taken into that side's bounds as it is
+            // decided (so the children need no pass of their own).
+            Side decided[2];
+            size_t i = begin, j = end;
+            while (i < j) {
+                const uint32_t item = order[i];
+                if (bucket_of(item, best_dim) <= best_bucket) {
+                    decided[0].add(items[item], centroid[item]);
+                    ++i;
+                } else {
+                    decided[1].add(items[item], centroid[item]);
+                    std::swap(order[i], order[--j]);
+                }
+            }
+            if (i > begin && i < end) {
+                halves[0] = decided[0];
+                halves[1] = decided[1];
+                return i;
+            }
         }
         int dim = extent.x >= extent.y && extent.x >= extent.z ? 0 : extent.y >= extent.z ? 1 : 2;
         size_t mid = begin + n / 2;
@@ -350,6 +379,7 @@ struct BinaryBuilder {
                              return centroid[a][dim] < centroid[b][dim] ||
                                     (centroid[a][dim] == centroid[b][dim] && a < b);
                          });
+        sides(begin, mid, end, halves);
         return mid;
     }
 };
