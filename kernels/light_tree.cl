@@ -74,9 +74,8 @@ inline bool light_tree_shares(global const LightTreeNode* node, float3 p, float3
     return true;
 }
 
-inline float light_slot_share(float4 share, uint slot) {
-    return slot == 0u ? share.x : slot == 1u ? share.y : slot == 2u ? share.z : share.w;
-}
+/* Component `slot` of share, by a shuffle rather than a branch on the slot. */
+inline float light_slot_share(float4 share, uint slot) { return shuffle(share, (uint4)(slot)).x; }
 
 /* Where [lo, hi) is cut between a part of share a (below) and one of share b (above), both
  * taken of the node's span: the smaller share's width is computed directly, so that both keep
@@ -84,11 +83,13 @@ inline float light_slot_share(float4 share, uint slot) {
 inline ulong light_tree_cut(ulong lo, ulong hi, float a, float b, float span) {
     ulong width = hi - lo;
     /* Through signed 64-bit conversions (span ≤ 2^62): the hardware's, where unsigned ones may
-     * be emulated. */
-    ulong t = a <= b ? min(width, (ulong)(long)(a * span))
-                     : width - min(width, (ulong)(long)(b * span));
-    if (a > 0.0f) t = max(t, min(width, 1ul));
-    if (b > 0.0f && width > 0ul) t = min(t, width - 1ul);
+     * be emulated. Both candidates, then a select: which share is smaller is a coin flip that
+     * a branch would mispredict. */
+    ulong from_a = min(width, (ulong)(long)(a * span));
+    ulong from_b = width - min(width, (ulong)(long)(b * span));
+    ulong t = select(from_b, from_a, (ulong)(a <= b));
+    t = select(t, max(t, min(width, 1ul)), (ulong)(a > 0.0f));
+    t = select(t, min(t, width - 1ul), (ulong)(b > 0.0f && width > 0ul));
     return lo + t;
 }
 
