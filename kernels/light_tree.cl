@@ -24,22 +24,29 @@ inline float4 light_slot_importance(global const LightTreeNode* node, float3 p, 
      * the box does not get an unbounded importance. pbrt-v4 writes max(d², |diagonal|/2),
      * comparing a squared distance with a length (its scale-dependent slip); this compares
      * squares. */
-    float4 inv_d2_clamped = one / max(d2, r2); /* off the chain of dependent operations below */
+    float4 inv_d2_clamped = one / max(d2, r2);
     int4 apart = d2 > zero;
     float4 inv_d = select(zero, one / sqrt(d2), apart);
-    float4 wx = dx * inv_d, wy = dy * inv_d, wz = select(one, dz * inv_d, apart); /* light → p */
+    /* Every cosine and sine below is a length times 1/d, the lengths' roots taken beside d's
+     * own: |d| cos θ = a · d and |d| sin θ = |a × d| = sqrt(d² − (a · d)²) for a unit a. Where
+     * p is the centre (d = 0), the direction is arbitrary: θ = 0. */
+    float4 along_axis = node->ax * dx + node->ay * dy + node->az * dz;
+    float4 along_normal = -(n.x * dx + n.y * dy + n.z * dz);
+    float4 across_axis = sqrt(max(zero, d2 - along_axis * along_axis));
+    float4 across_normal = sqrt(max(zero, d2 - along_normal * along_normal));
+    float4 beside_sphere = sqrt(max(zero, d2 - r2));
 
     /* θ_w: between the cone's axis and the direction to p; either way for two-sided lights. */
-    float4 cos_w = node->ax * wx + node->ay * wy + node->az * wz;
     int4 two_sided = ((uint4)(node->flags) & (uint4)(LIGHT_SLOT_TWO_SIDED, LIGHT_SLOT_TWO_SIDED << 1,
                                                      LIGHT_SLOT_TWO_SIDED << 2,
                                                      LIGHT_SLOT_TWO_SIDED << 3)) != (uint4)(0u);
-    cos_w = select(cos_w, fabs(cos_w), two_sided);
-    float4 sin_w = sqrt(max(zero, one - cos_w * cos_w));
+    along_axis = select(along_axis, fabs(along_axis), two_sided);
+    float4 cos_w = select(one, along_axis * inv_d, apart);
+    float4 sin_w = across_axis * inv_d;
     /* θ_b: half-angle of the bounding sphere seen from p; the whole sphere from inside it. */
     int4 outside = d2 > r2;
     float4 sin_b = select(one, min(r * inv_d, one), outside);
-    float4 cos_b = select(-one, sqrt(max(zero, one - sin_b * sin_b)), outside);
+    float4 cos_b = select(-one, beside_sphere * inv_d, outside);
     /* θ' = max(0, θ_w − θ_o − θ_b): the least angle between a normal and a direction to p. */
     float4 cos_o = node->cos_o, sin_o = node->sin_o;
     int4 in_cone = cos_w > cos_o;
@@ -48,8 +55,8 @@ inline float4 light_slot_importance(global const LightTreeNode* node, float3 p, 
     float4 cos_p = select(cos_x * cos_b + sin_x * sin_b, one, cos_x > cos_b);
 
     /* At the receiver: the least angle between n and a direction toward the sphere. */
-    float4 cos_i = -(n.x * wx + n.y * wy + n.z * wz);
-    float4 sin_i = sqrt(max(zero, one - cos_i * cos_i));
+    float4 cos_i = select(one, along_normal * inv_d, apart);
+    float4 sin_i = across_normal * inv_d;
     float4 cos_pi = select(cos_i * cos_b + sin_i * sin_b, one, cos_i > cos_b);
     float4 importance = node->phi * inv_d2_clamped * cos_p * cos_pi;
     return select(importance, zero, (cos_p <= node->cos_e) | (cos_pi <= zero));
