@@ -240,7 +240,7 @@ struct BinaryBuilder {
     }
 
     // The split of few lights: every cut between them in centroid order on each axis, the
-    // SAOH of each from running unions from both ends (the exact sweep the bins approximate).
+    // SAOH of each from bounds accumulated from both ends (the sweep the bins approximate).
     size_t sweep(size_t begin, size_t end, const glm::dvec3& diagonal, const glm::dvec3& extent,
                  Side* halves) {
         const size_t n = end - begin;
@@ -261,11 +261,11 @@ struct BinaryBuilder {
             below[0] = items[sorted[0]];
             for (size_t i = 1; i + 1 < n; ++i) {
                 below[i] = below[i - 1];
-                below[i].add(items[sorted[i]]);
+                below[i].add_estimate(items[sorted[i]]);
             }
             Bounds above;  // sorted[i + 1 ..]
             for (size_t i = n - 1; i-- > 0;) {
-                above.add(items[sorted[i + 1]]);
+                above.add_estimate(items[sorted[i + 1]]);
                 const double cost = saoh_cost(below[i], kr) + saoh_cost(above, kr);
                 if (cost < best_cost) {
                     best_cost = cost;
@@ -391,10 +391,11 @@ void set_slot(gpu::LightTreeNode& node, int k, const Bounds& b, uint32_t child, 
     const glm::dvec3 centre(float(0.5 * (b.lo.x + b.hi.x)), float(0.5 * (b.lo.y + b.hi.y)),
                             float(0.5 * (b.lo.z + b.hi.z)));
     const glm::dvec3 reach = glm::max(centre - b.lo, b.hi - centre);
-    // Widened by 1e-6 rad and rounded down, so that the float cone still holds every normal.
-    const double cos_o = b.normals.cos_theta <= -1.0
-                             ? -1.0
-                             : std::cos(std::min(kPi, safe_acos(b.normals.cos_theta) + 1e-6));
+    // Widened by ε = 1e-6 rad (cos(θ + ε) = cos θ cos ε − sin θ sin ε, −1 past π) and rounded
+    // down, so that the float cone still holds every normal.
+    const double c = std::clamp(b.normals.cos_theta, -1.0, 1.0), s = std::sqrt(1.0 - c * c);
+    const double cos_eps = 0.9999999999995, sin_eps = 1e-6;  // of ε, to double precision
+    const double cos_o = s * cos_eps + c * sin_eps < 0.0 ? -1.0 : c * cos_eps - s * sin_eps;
     const float cos_o_f = round_down(cos_o);
     (&node.x.x)[k] = float(centre.x);
     (&node.y.x)[k] = float(centre.y);

@@ -42,6 +42,7 @@ DEFAULT_SCENES = [
     ROOT / "scenes" / "stress" / "light-facing-away.gltf",
     ROOT / "scenes" / "stress" / "many-lights.gltf",
     ROOT / "out" / "many-lights" / "lamp-field.gltf",
+    ROOT / "out" / "many-lights" / "lamp-grid.gltf",
     ROOT / "out" / "many-lights" / "emissive-bunny.gltf",
     SHARED / "cornell" / "mcguire_CornellBox-Original" / "CornellBox-Original.gltf",
     SHARED / "lights" / "modern-hall" / "modern-hall.gltf",
