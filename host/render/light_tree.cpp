@@ -223,10 +223,14 @@ struct BinaryBuilder {
         node.right = index + uint32_t(2 * (mid - begin));
         const uint32_t left = node.left, right = node.right;
         if (mid - begin > kParallelGrain && end - mid > kParallelGrain && take_thread()) {
-            std::thread first([=, &halves] { build(begin, mid, left, depth + 1, &halves[0]); });
+            // The thread hands its place back as soon as its subtree is done, so that splits
+            // still running elsewhere can take it.
+            std::thread first([=, &halves] {
+                build(begin, mid, left, depth + 1, &halves[0]);
+                free_threads += 1;
+            });
             build(mid, end, right, depth + 1, &halves[1]);
             first.join();
-            free_threads += 1;
         } else {
             build(begin, mid, left, depth + 1, &halves[0]);
             build(mid, end, right, depth + 1, &halves[1]);
@@ -423,32 +427,53 @@ gpu::LightTreeNode empty_node() {
 
 // Collapses the binary tree two levels to a node: slots 0, 1 from the first child (itself if a
 // leaf, else its two children), slots 2, 3 from the second, so that the kernels' first cut,
-// between the two pairs, is the binary split.
+// between the two pairs, is the binary split. Nodes are laid out depth first; each subtree's
+// node count is counted first, so that subtrees are written apart (in parallel) into places
+// fixed by the tree alone.
 struct Collapser {
     const std::vector<BinaryNode>& binary;
     LightTree& out;
+    std::vector<uint32_t> count;  // per binary node collapsed into a node: that subtree's nodes
+    std::atomic<int> free_threads;
 
-    void collapse(uint32_t b, uint32_t index, uint32_t trail, uint32_t depth) {
-        out.nodes[index] = empty_node();
-        uint32_t slots[4];
-        int used[4] = {0, 0, 0, 0};
+    // The slots of the node that binary node b becomes.
+    int slots_of(uint32_t b, uint32_t* slots, int* used) const {
+        int n = 0;
         const uint32_t halves[2] = {binary[b].left, binary[b].right};
         for (int h = 0; h < 2; ++h) {
             const BinaryNode& c = binary[halves[h]];
-            if (c.leaf) {
-                slots[2 * h] = halves[h];
-                used[2 * h] = 1;
-            } else {
-                slots[2 * h] = c.left;
-                slots[2 * h + 1] = c.right;
-                used[2 * h] = used[2 * h + 1] = 1;
-            }
+            used[2 * h] = 1;
+            used[2 * h + 1] = c.leaf ? 0 : 1;
+            slots[2 * h] = c.leaf ? halves[h] : c.left;
+            slots[2 * h + 1] = c.leaf ? 0u : c.right;
+            n += c.leaf ? 1 : 2;
         }
+        return n;
+    }
+
+    uint32_t count_nodes(uint32_t b) {
+        uint32_t slots[4];
+        int used[4];
+        slots_of(b, slots, used);
+        uint32_t n = 1;
+        for (int k = 0; k < 4; ++k)
+            if (used[k] && !binary[slots[k]].leaf) n += count_nodes(slots[k]);
+        count[b] = n;
+        return n;
+    }
+
+    void collapse(uint32_t b, uint32_t index, uint32_t trail, uint32_t depth) {
+        uint32_t slots[4];
+        int used[4];
+        slots_of(b, slots, used);
         place(slots, used, index, trail, depth);
     }
 
     void place(const uint32_t* slots, const int* used, uint32_t index, uint32_t trail,
                uint32_t depth) {
+        out.nodes[index] = empty_node();
+        uint32_t next = index + 1;
+        std::vector<std::thread> threads;
         for (int k = 0; k < 4; ++k) {
             if (!used[k]) continue;
             const BinaryNode& c = binary[slots[k]];
@@ -456,13 +481,28 @@ struct Collapser {
             if (c.leaf) {
                 set_slot(out.nodes[index], k, c.bounds, c.light, true);
                 out.paths[c.light] = {slot_trail, depth + 1};
+                continue;
+            }
+            const uint32_t child = next, b = slots[k];
+            next += count[b];
+            set_slot(out.nodes[index], k, c.bounds, child, false);
+            if (count[b] > kParallelGrain && take_thread()) {
+                threads.emplace_back([=] {
+                    collapse(b, child, slot_trail, depth + 1);
+                    free_threads += 1;
+                });
             } else {
-                const uint32_t child = uint32_t(out.nodes.size());
-                out.nodes.emplace_back();
-                set_slot(out.nodes[index], k, c.bounds, child, false);
-                collapse(slots[k], child, slot_trail, depth + 1);
+                collapse(b, child, slot_trail, depth + 1);
             }
         }
+        for (std::thread& t : threads) t.join();
+    }
+
+    bool take_thread() {
+        int n = free_threads.load();
+        while (n > 0)
+            if (free_threads.compare_exchange_weak(n, n - 1)) return true;
+        return false;
     }
 };
 
@@ -472,17 +512,54 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
                            const std::vector<double>& powers, int threads) {
     LightTree tree;
     tree.paths.assign(lights.size(), gpu::LightTreePath{0u, 0u});
-    std::vector<Bounds> items(lights.size());
-    std::vector<glm::dvec3> centroid(lights.size());
-    std::vector<uint32_t> order;
-    for (size_t i = 0; i < lights.size(); ++i) {
+    auto vertices = [&](size_t i, glm::dvec3* p) {
         const gpu::Light& l = lights[i];
-        glm::dvec3 p[3] = {
-            {l.p0.x, l.p0.y, l.p0.z}, {l.p1.x, l.p1.y, l.p1.z}, {l.p2.x, l.p2.y, l.p2.z}};
-        glm::dvec3 normal = glm::cross(p[1] - p[0], p[2] - p[0]);
-        double length = glm::length(normal);
+        p[0] = {l.p0.x, l.p0.y, l.p0.z};
+        p[1] = {l.p1.x, l.p1.y, l.p1.z};
+        p[2] = {l.p2.x, l.p2.y, l.p2.z};
+    };
+    // The lights with power in Morton order of their centroids (Morton 1966): a subtree's
+    // lights then lie together in memory, which the splits' passes over them read in far fewer
+    // cache lines.
+    std::vector<glm::dvec3> centre(lights.size());
+    Bounds box;
+    std::vector<uint64_t> keys;
+    for (size_t i = 0; i < lights.size(); ++i) {
         if (!(powers[i] > 0.0)) continue;
-        Bounds& b = items[i];
+        glm::dvec3 p[3];
+        vertices(i, p);
+        centre[i] = 0.5 * (glm::min(p[0], glm::min(p[1], p[2])) + glm::max(p[0], glm::max(p[1], p[2])));
+        box.lo = glm::min(box.lo, centre[i]);
+        box.hi = glm::max(box.hi, centre[i]);
+        keys.push_back(i);
+    }
+    if (keys.empty()) return tree;
+    const glm::dvec3 extent = glm::max(box.hi - box.lo, glm::dvec3(1e-300));
+    auto spread = [](uint32_t v) {  // the 10 bits of v, two zero bits between each
+        v = (v | (v << 16)) & 0x030000FFu;
+        v = (v | (v << 8)) & 0x0300F00Fu;
+        v = (v | (v << 4)) & 0x030C30C3u;
+        return (v | (v << 2)) & 0x09249249u;
+    };
+    for (uint64_t& key : keys) {
+        const glm::dvec3 t = (centre[key] - box.lo) / extent * 1023.0;
+        const uint32_t code = spread(uint32_t(t.x)) | (spread(uint32_t(t.y)) << 1) |
+                              (spread(uint32_t(t.z)) << 2);
+        key |= uint64_t(code) << 32;
+    }
+    std::sort(keys.begin(), keys.end());
+    // Item k: the bounds of light light_of[k].
+    const size_t count = keys.size();
+    std::vector<Bounds> items(count);
+    std::vector<glm::dvec3> centroid(count);
+    std::vector<uint32_t> light_of(count), order(count);
+    for (size_t k = 0; k < count; ++k) {
+        const uint32_t i = uint32_t(keys[k]);
+        glm::dvec3 p[3];
+        vertices(i, p);
+        const glm::dvec3 normal = glm::cross(p[1] - p[0], p[2] - p[0]);
+        const double length = glm::length(normal);
+        Bounds& b = items[k];
         b.lo = glm::min(p[0], glm::min(p[1], p[2]));
         b.hi = glm::max(p[0], glm::max(p[1], p[2]));
         b.phi = powers[i];
@@ -491,62 +568,25 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
         // A sliver whose normal is lost to rounding may emit anywhere: the whole sphere.
         b.normals = length > 0.0 ? Cone{normal / length, 1.0, false} : whole_sphere({0, 0, 1});
         b.cos_e = 0.0;
-        b.two_sided = (l.flags & MATERIAL_DOUBLE_SIDED) != 0u;
-        centroid[i] = 0.5 * (b.lo + b.hi);
-        order.push_back(uint32_t(i));
+        b.two_sided = (lights[i].flags & MATERIAL_DOUBLE_SIDED) != 0u;
+        centroid[k] = centre[i];
+        light_of[k] = i;
+        order[k] = uint32_t(k);
     }
-    if (order.empty()) return tree;
-    // The lights in Morton order of their centroids (Morton 1966): a subtree's lights then lie
-    // together in memory, which the splits' passes over them read in far fewer cache lines.
-    {
-        Bounds box;
-        for (uint32_t i : order) {
-            box.lo = glm::min(box.lo, centroid[i]);
-            box.hi = glm::max(box.hi, centroid[i]);
-        }
-        const glm::dvec3 extent = glm::max(box.hi - box.lo, glm::dvec3(1e-300));
-        auto spread = [](uint32_t v) {  // the 10 bits of v, two zero bits between each
-            v = (v | (v << 16)) & 0x030000FFu;
-            v = (v | (v << 8)) & 0x0300F00Fu;
-            v = (v | (v << 4)) & 0x030C30C3u;
-            return (v | (v << 2)) & 0x09249249u;
-        };
-        std::vector<uint64_t> keys(order.size());
-        for (size_t k = 0; k < order.size(); ++k) {
-            const glm::dvec3 t = (centroid[order[k]] - box.lo) / extent * 1023.0;
-            const uint32_t code = spread(uint32_t(t.x)) | (spread(uint32_t(t.y)) << 1) |
-                                  (spread(uint32_t(t.z)) << 2);
-            keys[k] = (uint64_t(code) << 32) | order[k];
-        }
-        std::sort(keys.begin(), keys.end());
-        std::vector<Bounds> sorted_items(keys.size());
-        std::vector<glm::dvec3> sorted_centroid(keys.size());
-        for (size_t k = 0; k < keys.size(); ++k) {
-            const uint32_t light = uint32_t(keys[k]);
-            sorted_items[k] = items[light];
-            sorted_centroid[k] = centroid[light];
-            order[k] = light;  // now: the light of sorted item k
-        }
-        items.swap(sorted_items);
-        centroid.swap(sorted_centroid);
-    }
-    const std::vector<uint32_t> light_of = order;
-    for (size_t k = 0; k < order.size(); ++k) order[k] = uint32_t(k);
     std::vector<BinaryNode> binary(2 * order.size() - 1);
     if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
     BinaryBuilder builder{items, centroid, order, binary, {threads - 1}};
     builder.build(0, order.size(), 0u, 0, nullptr);
     for (BinaryNode& node : binary)
         if (node.leaf) node.light = light_of[node.light];
-    tree.nodes.reserve(order.size() / 2 + 1);
-    tree.nodes.emplace_back();
-    Collapser collapser{binary, tree};
+    Collapser collapser{binary, tree, std::vector<uint32_t>(binary.size(), 0u), {threads - 1}};
     if (binary[0].leaf) {  // one light: a root of one slot
         const uint32_t slots[4] = {0u, 0u, 0u, 0u};
         const int used[4] = {1, 0, 0, 0};
-        tree.nodes[0] = empty_node();
+        tree.nodes.resize(1);
         collapser.place(slots, used, 0u, 0u, 0u);
     } else {
+        tree.nodes.resize(collapser.count_nodes(0u));
         collapser.collapse(0u, 0u, 0u, 0u);
     }
     return tree;
