@@ -974,8 +974,9 @@ TEST_CASE("light tree: every light in one slot, bounds hold what is below them",
 
 TEST_CASE("light tree: the parallel build gives the same tree whatever the number of threads",
           "[sampling][light-tree]") {
-    // Enough lights that subtrees are built on threads of their own (kParallelGrain).
-    TreeLights t = tree_lights(60000, 23u, 100);
+    // Enough lights that subtrees are built, and collapsed, on threads of their own (more than
+    // kParallelGrain lights and nodes).
+    TreeLights t = tree_lights(150000, 23u, 100);
     LightTree one = build_light_tree(t.lights, t.powers, 1);
     for (int threads : {2, 3, 8}) {
         INFO("threads " << threads);
