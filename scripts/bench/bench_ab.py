@@ -15,8 +15,13 @@ speed drifts by tens of per cent over minutes), and says whether its image is
 bitwise that of the first variant (the pixels' float bits, not the file: the file's attributes
 hold times).
 
+A variant may also add options of its own (--variant-options LABEL="..."), so that one binary's
+settings compare: --variant power=build/mcrt --variant tree=build/mcrt --variant-options
+power="--light-select power" --variant-options tree="--light-select tree".
+
 Usage: scripts/bench/bench_ab.py --variant old=build-old/mcrt --variant new=build/mcrt [--rounds 5]
-           [--width 256 --height 256 --spp 64] [--options "--estimator mis"] SCENE...
+           [--width 256 --height 256 --spp 64] [--options "--estimator mis"]
+           [--variant-options LABEL="OPTIONS"]... SCENE...
 Needs numpy (Debian's python3-numpy; /usr/bin/python3).
 """
 
@@ -47,13 +52,20 @@ def cpu_seconds():
     return usage.ru_utime + usage.ru_stime
 
 
-def render(variant, scene, stem, options):
+def parse_variant_options(text):
+    label, sep, rest = text.partition("=")
+    if not sep or not label:
+        raise argparse.ArgumentTypeError("expected LABEL=OPTIONS, got %r" % text)
+    return label, shlex.split(rest)
+
+
+def render(variant, scene, stem, options, extra=()):
     """The Render of one variant, with .cpu_seconds: the whole process's CPU time (set-up
     included), which another job on the machine inflates far less than the kernel's wall time."""
     label, binary, kernels = variant
     env = {"MCRT_KERNEL_DIR": kernels or ""}  # empty: the binary's embedded kernels
     start = cpu_seconds()
-    r = mcrt_run.render(scene, stem, options, mcrt=binary, env=env)
+    r = mcrt_run.render(scene, stem, list(options) + list(extra), mcrt=binary, env=env)
     r.cpu_seconds = cpu_seconds() - start
     return r
 
@@ -74,8 +86,16 @@ def main():
     p.add_argument("--spp", type=int, default=64)
     p.add_argument("--options", default="--estimator mis --materials lambert",
                    help="mcrt render options for every variant")
+    p.add_argument("--variant-options", action="append", type=parse_variant_options, default=[],
+                   help="LABEL=OPTIONS: mcrt render options for that variant only")
     p.add_argument("--json", help="also write the raw figures here")
     args = p.parse_args()
+    labels = [v[0] for v in args.variant]
+    extra = {}
+    for label, opts in args.variant_options:
+        if label not in labels:
+            p.error("--variant-options %s: no such variant" % label)
+        extra[label] = extra.get(label, []) + opts
     mcrt_run.require("numpy")
     options = ["--width", args.width, "--height", args.height, "--spp", args.spp] + \
         shlex.split(args.options)
@@ -85,10 +105,11 @@ def main():
             images = {}
             rates, cpu_rates = {v[0]: [] for v in args.variant}, {v[0]: [] for v in args.variant}
             for v in args.variant:  # warm each variant's kernel cache; keep its image
-                images[v[0]] = render(v, scene, Path(scratch) / v[0], options).rgb
+                images[v[0]] = render(v, scene, Path(scratch) / v[0], options,
+                                      extra.get(v[0], ())).rgb
             for _ in range(args.rounds):
                 for v in args.variant:
-                    r = render(v, scene, Path(scratch) / v[0], options)
+                    r = render(v, scene, Path(scratch) / v[0], options, extra.get(v[0], ()))
                     rates[v[0]].append(r.stats["samples_per_second"])
                     samples = args.width * args.height * args.spp
                     cpu_rates[v[0]].append(samples / r.cpu_seconds)
@@ -110,6 +131,9 @@ def main():
                              "bitwise_same": same_bits(images[label], images[base])})
                 print("bench_ab: %s" % json.dumps(rows[-1]), file=sys.stderr)
     print("options: %s; %d rounds, alternating" % (" ".join(str(o) for o in options), args.rounds))
+    for label in labels:
+        if extra.get(label):
+            print("%s: %s" % (label, " ".join(extra[label])))
     print()
     print("| scene | variant | Msamples/s median (range) | ratio to %s | paired ratio median "
           "(range) | samples per CPU µs median (range) | ratio | image bitwise %s's |"
