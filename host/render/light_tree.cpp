@@ -6,6 +6,9 @@
 #include <glm/glm.hpp>
 #include <atomic>
 #include <limits>
+#include <memory>
+#include <new>
+#include <type_traits>
 #include <thread>
 
 namespace mcrt {
@@ -162,11 +165,24 @@ int ceil_log2(size_t n) {
     return k;
 }
 
+// fn(begin, end) over [0, n) in `threads` contiguous parts at once.
+template <typename Fn>
+void parallel_for(int threads, size_t n, Fn fn) {
+    std::vector<std::thread> workers;
+    const size_t parts = n < 65536 ? 1 : size_t(std::max(1, threads));
+    for (size_t t = 1; t < parts; ++t)
+        workers.emplace_back([=] { fn(n * t / parts, n * (t + 1) / parts); });
+    fn(0, n / parts);
+    for (std::thread& w : workers) w.join();
+}
+
 // Longest path of the binary tree, in edges: collapsed two levels to a node, its lights lie at
 // most MCRT_LIGHT_TREE_MAX_DEPTH nodes deep.
 constexpr int kMaxBinaryDepth = 2 * MCRT_LIGHT_TREE_MAX_DEPTH;
 // Subtrees of more lights than this are built on a thread of their own while threads are free.
 constexpr size_t kParallelGrain = 8192;
+// Splits of more than twice this many lights bin and partition in chunks of it, in parallel.
+constexpr size_t kChunk = size_t(1) << 16;
 // Splits of at most this many lights are found by a sweep, of more by the bins.
 constexpr size_t kSweepMax = 16;
 
@@ -186,8 +202,14 @@ struct BinaryBuilder {
     const std::vector<Bounds>& items;
     const std::vector<glm::dvec3>& centroid;
     std::vector<uint32_t>& order;  // items of the tree, permuted in place by the splits
-    std::vector<BinaryNode>& nodes;
+    BinaryNode* nodes;  // storage for 2 · lights − 1, each constructed as its subtree is built
     std::atomic<int> free_threads;
+
+    // The bins of one axis each: bounds (estimated cones) and counts.
+    struct Bins {
+        Bounds bucket[3][kBuckets];
+        size_t count[3][kBuckets] = {};
+    };
 
     // What the parent's split found out about the lights of a child: their bounds and the box
     // of their centroids.
@@ -204,7 +226,9 @@ struct BinaryBuilder {
 
     // `given`: what is known of order[begin, end), nullptr at the root.
     void build(size_t begin, size_t end, uint32_t index, int depth, const Side* given) {
-        BinaryNode& node = nodes[index];
+        // Constructed here, on the thread that builds it: the pages are first touched in
+        // parallel.
+        BinaryNode& node = *new (&nodes[index]) BinaryNode();
         Side all;
         if (given != nullptr) {
             all = *given;
@@ -316,16 +340,47 @@ struct BinaryBuilder {
         };
         if (!balance && n <= kSweepMax) return sweep(begin, end, diagonal, extent, halves);
         if (!balance) {
-            Bounds bucket[3][kBuckets];
-            size_t count[3][kBuckets] = {};
-            for (size_t i = begin; i < end; ++i) {
-                const uint32_t item = order[i];
-                for (int dim = 0; dim < 3; ++dim) {
-                    if (!(extent[dim] > 0.0)) continue;
-                    int b = bucket_of(item, dim);
-                    bucket[dim][b].add_estimate(items[item]);
-                    ++count[dim][b];
+            Bins all_bins;
+            Bounds (&bucket)[3][kBuckets] = all_bins.bucket;
+            size_t (&count)[3][kBuckets] = all_bins.count;
+            auto bin = [&](size_t from, size_t to, Bins& bins) {
+                for (size_t i = from; i < to; ++i) {
+                    const uint32_t item = order[i];
+                    for (int dim = 0; dim < 3; ++dim) {
+                        if (!(extent[dim] > 0.0)) continue;
+                        int b = bucket_of(item, dim);
+                        bins.bucket[dim][b].add_estimate(items[item]);
+                        ++bins.count[dim][b];
+                    }
                 }
+            };
+            if (n <= 2 * kChunk) {
+                bin(begin, end, all_bins);
+            } else {
+                // Many lights (the top levels, which run before there are subtrees to share
+                // out): binned in fixed chunks, half of them on a free thread, and merged in
+                // chunk order, the same for any number of threads.
+                const size_t chunks = (n + kChunk - 1) / kChunk;
+                std::vector<Bins> parts(chunks);
+                auto bin_chunks = [&](size_t from, size_t to) {
+                    for (size_t c = from; c < to; ++c)
+                        bin(begin + c * kChunk, std::min(end, begin + (c + 1) * kChunk), parts[c]);
+                };
+                if (take_thread()) {
+                    std::thread helper([&] { bin_chunks(0, chunks / 2); });
+                    bin_chunks(chunks / 2, chunks);
+                    helper.join();
+                    free_threads += 1;
+                } else {
+                    bin_chunks(0, chunks);
+                }
+                for (const Bins& part : parts)
+                    for (int dim = 0; dim < 3; ++dim)
+                        for (int b = 0; b < kBuckets; ++b) {
+                            if (part.count[dim][b] == 0) continue;
+                            bucket[dim][b].add_estimate(part.bucket[dim][b]);
+                            count[dim][b] += part.count[dim][b];
+                        }
             }
             const double max_extent = std::max({diagonal.x, diagonal.y, diagonal.z});
             for (int dim = 0; dim < 3; ++dim) {
@@ -355,7 +410,28 @@ struct BinaryBuilder {
                 }
             }
         }
-        if (best_dim >= 0) {
+        if (best_dim >= 0 && n > 2 * kChunk) {
+            // Many lights: partitioned first, then each side's bounds taken on a thread.
+            auto it = std::partition(
+                order.begin() + long(begin), order.begin() + long(end),
+                [&](uint32_t item) { return bucket_of(item, best_dim) <= best_bucket; });
+            const size_t mid = size_t(it - order.begin());
+            if (mid > begin && mid < end) {
+                auto side = [&](size_t from, size_t to, Side& out) {
+                    for (size_t i = from; i < to; ++i) out.add(items[order[i]], centroid[order[i]]);
+                };
+                if (take_thread()) {
+                    std::thread helper([&] { side(begin, mid, halves[0]); });
+                    side(mid, end, halves[1]);
+                    helper.join();
+                    free_threads += 1;
+                } else {
+                    side(begin, mid, halves[0]);
+                    side(mid, end, halves[1]);
+                }
+                return mid;
+            }
+        } else if (best_dim >= 0) {
             // Partitioned in place, each light's side taken into that side's bounds as it is
             // decided (so the children need no pass of their own).
             Side decided[2];
@@ -431,7 +507,7 @@ gpu::LightTreeNode empty_node() {
 // node count is counted first, so that subtrees are written apart (in parallel) into places
 // fixed by the tree alone.
 struct Collapser {
-    const std::vector<BinaryNode>& binary;
+    const BinaryNode* binary;
     LightTree& out;
     std::vector<uint32_t> count;  // per binary node collapsed into a node: that subtree's nodes
     std::atomic<int> free_threads;
@@ -541,45 +617,62 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
         v = (v | (v << 4)) & 0x030C30C3u;
         return (v | (v << 2)) & 0x09249249u;
     };
-    for (uint64_t& key : keys) {
-        const glm::dvec3 t = (centre[key] - box.lo) / extent * 1023.0;
-        const uint32_t code = spread(uint32_t(t.x)) | (spread(uint32_t(t.y)) << 1) |
-                              (spread(uint32_t(t.z)) << 2);
-        key |= uint64_t(code) << 32;
+    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+    parallel_for(threads, keys.size(), [&](size_t begin, size_t end) {
+        for (size_t k = begin; k < end; ++k) {
+            const glm::dvec3 t = (centre[keys[k]] - box.lo) / extent * 1023.0;
+            const uint32_t code = spread(uint32_t(t.x)) | (spread(uint32_t(t.y)) << 1) |
+                                  (spread(uint32_t(t.z)) << 2);
+            keys[k] |= uint64_t(code) << 32;
+        }
+    });
+    // Sorted in two halves at once, then merged (the keys are distinct: the same order).
+    {
+        const auto middle = keys.begin() + long(keys.size() / 2);
+        std::thread first([&] { std::sort(keys.begin(), middle); });
+        std::sort(middle, keys.end());
+        first.join();
+        std::inplace_merge(keys.begin(), middle, keys.end());
     }
-    std::sort(keys.begin(), keys.end());
     // Item k: the bounds of light light_of[k].
     const size_t count = keys.size();
     std::vector<Bounds> items(count);
     std::vector<glm::dvec3> centroid(count);
     std::vector<uint32_t> light_of(count), order(count);
-    for (size_t k = 0; k < count; ++k) {
-        const uint32_t i = uint32_t(keys[k]);
-        glm::dvec3 p[3];
-        vertices(i, p);
-        const glm::dvec3 normal = glm::cross(p[1] - p[0], p[2] - p[0]);
-        const double length = glm::length(normal);
-        Bounds& b = items[k];
-        b.lo = glm::min(p[0], glm::min(p[1], p[2]));
-        b.hi = glm::max(p[0], glm::max(p[1], p[2]));
-        b.phi = powers[i];
-        // An area light: its normal, emitting over the hemisphere (θ_o = 0, θ_e = π/2), on
-        // both sides when double-sided (pbrt-v4's DiffuseAreaLight::Bounds).
-        // A sliver whose normal is lost to rounding may emit anywhere: the whole sphere.
-        b.normals = length > 0.0 ? Cone{normal / length, 1.0, false} : whole_sphere({0, 0, 1});
-        b.cos_e = 0.0;
-        b.two_sided = (lights[i].flags & MATERIAL_DOUBLE_SIDED) != 0u;
-        centroid[k] = centre[i];
-        light_of[k] = i;
-        order[k] = uint32_t(k);
-    }
-    std::vector<BinaryNode> binary(2 * order.size() - 1);
-    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+    parallel_for(threads, count, [&](size_t begin, size_t end) {
+        for (size_t k = begin; k < end; ++k) {
+            const uint32_t i = uint32_t(keys[k]);
+            glm::dvec3 p[3];
+            vertices(i, p);
+            const glm::dvec3 normal = glm::cross(p[1] - p[0], p[2] - p[0]);
+            const double length = glm::length(normal);
+            Bounds& b = items[k];
+            b.lo = glm::min(p[0], glm::min(p[1], p[2]));
+            b.hi = glm::max(p[0], glm::max(p[1], p[2]));
+            b.phi = powers[i];
+            // An area light: its normal, emitting over the hemisphere (θ_o = 0, θ_e = π/2), on
+            // both sides when double-sided (pbrt-v4's DiffuseAreaLight::Bounds).
+            // A sliver whose normal is lost to rounding may emit anywhere: the whole sphere.
+            b.normals = length > 0.0 ? Cone{normal / length, 1.0, false} : whole_sphere({0, 0, 1});
+            b.cos_e = 0.0;
+            b.two_sided = (lights[i].flags & MATERIAL_DOUBLE_SIDED) != 0u;
+            centroid[k] = centre[i];
+            light_of[k] = i;
+            order[k] = uint32_t(k);
+        }
+    });
+    const size_t binary_count = 2 * order.size() - 1;
+    using Storage = std::aligned_storage_t<sizeof(BinaryNode), alignof(BinaryNode)>;
+    static_assert(std::is_trivially_destructible_v<BinaryNode>);
+    std::unique_ptr<Storage[]> storage(new Storage[binary_count]);  // not initialised
+    BinaryNode* binary = reinterpret_cast<BinaryNode*>(storage.get());
     BinaryBuilder builder{items, centroid, order, binary, {threads - 1}};
     builder.build(0, order.size(), 0u, 0, nullptr);
-    for (BinaryNode& node : binary)
-        if (node.leaf) node.light = light_of[node.light];
-    Collapser collapser{binary, tree, std::vector<uint32_t>(binary.size(), 0u), {threads - 1}};
+    parallel_for(threads, binary_count, [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i)
+            if (binary[i].leaf) binary[i].light = light_of[binary[i].light];
+    });
+    Collapser collapser{binary, tree, std::vector<uint32_t>(binary_count, 0u), {threads - 1}};
     if (binary[0].leaf) {  // one light: a root of one slot
         const uint32_t slots[4] = {0u, 0u, 0u, 0u};
         const int used[4] = {1, 0, 0, 0};
