@@ -9,6 +9,7 @@
 #include <memory>
 #include <new>
 #include <type_traits>
+#include <system_error>
 #include <thread>
 
 namespace mcrt {
@@ -165,13 +166,36 @@ int ceil_log2(size_t n) {
     return k;
 }
 
-// fn(begin, end) over [0, n) in `threads` contiguous parts at once.
+// Runs a on a thread of its own beside b on this one, or both here where the process may
+// start no thread (a limit on processes): the same results either way.
+template <typename A, typename B>
+void beside(A&& a, B&& b) {
+    std::thread thread;
+    try {
+        thread = std::thread(a);
+    } catch (const std::system_error&) {
+        a();
+        b();
+        return;
+    }
+    b();
+    thread.join();
+}
+
+// fn(begin, end) over [0, n) in `threads` contiguous parts at once (those no thread could be
+// started for run here).
 template <typename Fn>
 void parallel_for(int threads, size_t n, Fn fn) {
     std::vector<std::thread> workers;
     const size_t parts = n < 65536 ? 1 : size_t(std::max(1, threads));
-    for (size_t t = 1; t < parts; ++t)
-        workers.emplace_back([=] { fn(n * t / parts, n * (t + 1) / parts); });
+    for (size_t t = 1; t < parts; ++t) {
+        auto part = [=] { fn(n * t / parts, n * (t + 1) / parts); };
+        try {
+            workers.emplace_back(part);
+        } catch (const std::system_error&) {
+            part();
+        }
+    }
     fn(0, n / parts);
     for (std::thread& w : workers) w.join();
 }
@@ -249,12 +273,12 @@ struct BinaryBuilder {
         if (mid - begin > kParallelGrain && end - mid > kParallelGrain && take_thread()) {
             // The thread hands its place back as soon as its subtree is done, so that splits
             // still running elsewhere can take it.
-            std::thread first([=, &halves] {
-                build(begin, mid, left, depth + 1, &halves[0]);
-                free_threads += 1;
-            });
-            build(mid, end, right, depth + 1, &halves[1]);
-            first.join();
+            beside(
+                [=, &halves] {
+                    build(begin, mid, left, depth + 1, &halves[0]);
+                    free_threads += 1;
+                },
+                [=, &halves] { build(mid, end, right, depth + 1, &halves[1]); });
         } else {
             build(begin, mid, left, depth + 1, &halves[0]);
             build(mid, end, right, depth + 1, &halves[1]);
@@ -367,9 +391,7 @@ struct BinaryBuilder {
                         bin(begin + c * kChunk, std::min(end, begin + (c + 1) * kChunk), parts[c]);
                 };
                 if (take_thread()) {
-                    std::thread helper([&] { bin_chunks(0, chunks / 2); });
-                    bin_chunks(chunks / 2, chunks);
-                    helper.join();
+                    beside([&] { bin_chunks(0, chunks / 2); }, [&] { bin_chunks(chunks / 2, chunks); });
                     free_threads += 1;
                 } else {
                     bin_chunks(0, chunks);
@@ -421,9 +443,7 @@ struct BinaryBuilder {
                     for (size_t i = from; i < to; ++i) out.add(items[order[i]], centroid[order[i]]);
                 };
                 if (take_thread()) {
-                    std::thread helper([&] { side(begin, mid, halves[0]); });
-                    side(mid, end, halves[1]);
-                    helper.join();
+                    beside([&] { side(begin, mid, halves[0]); }, [&] { side(mid, end, halves[1]); });
                     free_threads += 1;
                 } else {
                     side(begin, mid, halves[0]);
@@ -563,10 +583,15 @@ struct Collapser {
             next += count[b];
             set_slot(out.nodes[index], k, c.bounds, child, false);
             if (count[b] > kParallelGrain && take_thread()) {
-                threads.emplace_back([=] {
+                auto task = [=] {
                     collapse(b, child, slot_trail, depth + 1);
                     free_threads += 1;
-                });
+                };
+                try {
+                    threads.emplace_back(task);
+                } catch (const std::system_error&) {
+                    task();
+                }
             } else {
                 collapse(b, child, slot_trail, depth + 1);
             }
@@ -629,9 +654,7 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
     // Sorted in two halves at once, then merged (the keys are distinct: the same order).
     {
         const auto middle = keys.begin() + long(keys.size() / 2);
-        std::thread first([&] { std::sort(keys.begin(), middle); });
-        std::sort(middle, keys.end());
-        first.join();
+        beside([&] { std::sort(keys.begin(), middle); }, [&] { std::sort(middle, keys.end()); });
         std::inplace_merge(keys.begin(), middle, keys.end());
     }
     // Item k: the bounds of light light_of[k].
