@@ -35,10 +35,10 @@ STAGES = [
      "light_sample_pdf_w(&ls);",
      "        if (true) {\n            float pdf_light = light_sample_pdf_w(&ls);"),
     ("BSDF ray (closest hit and its surface point)", "estimators.cl",
-     "        if (trace_from(scene, sp, bs.wi, rays, &seen)) {\n            float3 Le = "
+     "        if (trace_bsdf_sample(scene, sp, &bs, rays, &seen)) {\n            float3 Le = "
      "emitted_radiance(&seen);",
-     "        if (as_uint(bs.wi.x) == 0x12345u && trace_from(scene, sp, bs.wi, rays, &seen)) {\n"
-     "            float3 Le = emitted_radiance(&seen);"),
+     "        if (as_uint(bs.wi.x) == 0x12345u && trace_bsdf_sample(scene, sp, &bs, rays, "
+     "&seen)) {\n            float3 Le = emitted_radiance(&seen);"),
     ("the estimator (light and BSDF sampling, both rays, MIS)", "path.cl",
      "        L += beta * MCRT_ESTIMATE(scene, &sp, stream, &record->rays);",
      "        L += beta * sp.n;"),
