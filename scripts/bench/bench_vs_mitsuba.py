@@ -11,8 +11,8 @@ independent, as Mitsuba's scene is mitsuba_reference.py's diffuse conversion):
               ↔ `path`, max_depth D + 1, rr_depth 5 (mitsuba_reference.py's mapping)
 SCENE:sky renders a scene without emitters under --sky 1 in both (a `constant` emitter).
 --device SPEC renders mcrt's side on that device (mcrt render --device: an index, `pocl`,
-`intel`, ...; default mcrt's first device); Intel's OpenCL runtime is visible under
-scripts/with-intel, which the script's own Python and Mitsuba do not use.
+`intel`, ...; default mcrt's first device); Intel's OpenCL runtime is visible when the script
+runs under scripts/with-intel (Mitsuba uses no OpenCL).
 The light strategies still differ where the scene's lights do: Mitsuba picks an emitter (one
 mesh per emissive material) uniformly, then a point by area, mcrt a triangle by power (the same
 with one emissive material); Mitsuba samples the sky uniformly on the sphere, mcrt cosine-
