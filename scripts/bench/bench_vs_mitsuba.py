@@ -277,11 +277,13 @@ def table(rows, args, variant):
             r["mcrt_surfaces_mean"], r["mitsuba_surfaces_mean"], difference))
     lines.append("")
     devices = sorted({r["mcrt_device"] for r in rows})
-    lines.append("mcrt on --device %s (%s); %dx%d, %d rounds; mcrt's time: seconds_render_wall of its stats. RMSE against a "
-                 "%d spp mcrt reference, its noise subtracted, over the pixels that see no "
-                 "emitter (nor one next to such a pixel); (…) mcrt's RMSE·√(t_mcrt/t_Mitsuba). "
-                 "Image means over the same pixels, ± the standard error from the rounds." % (
-                     args.device or "default", ", ".join(devices), args.width, args.height, args.rounds, args.reference_spp))
+    lines.append("mcrt on --device %s (%s); %dx%d, %d rounds; mcrt's time: seconds_render_wall "
+                 "of its stats. RMSE against a %d spp mcrt reference, its noise subtracted, over "
+                 "the pixels that see no emitter (nor one next to such a pixel); (…) mcrt's "
+                 "RMSE·√(t_mcrt/t_Mitsuba). Image means over the same pixels, ± the standard "
+                 "error from the rounds." % (
+                     args.device or "default", ", ".join(devices), args.width, args.height,
+                     args.rounds, args.reference_spp))
     return "\n".join(lines) + "\n"
 
 
@@ -345,7 +347,8 @@ def main():
         "python": sys.executable, "mcrt": os.path.abspath(mcrt), "mcrt_commit": git_revision(),
         "mitsuba_version": mi.__version__, "mitsuba_variant": args.variant,
         "width": args.width, "height": args.height, "spp": args.spp, "rounds": args.rounds,
-        "depth": args.depth, "device": args.device, "reference_spp": args.reference_spp, "rows": rows},
+        "depth": args.depth, "device": args.device, "reference_spp": args.reference_spp,
+        "rows": rows},
         indent=1) + "\n")
     print(text)
 
