@@ -10,16 +10,21 @@
  * and an image is the same bits whichever device renders it (docs/DESIGN.md, "Determinism"). It
  * holds to the end of each program, user estimator files included. */
 #pragma OPENCL FP_CONTRACT OFF
-#include "arithmetic.cl"
-
-/* Intel's CPU runtime (2026.2), where the host defines MCRT_INTEL_NO_VECTORIZE: every kernel
- * runs one work-item at a time, as on PoCL, instead of vectorised across work-items. Its
- * vectoriser returns wrong values from any function it does not inline that returns a float3
- * (four lines show it: docs/ROBUSTNESS.md), which mcrt's larger functions are, and crashes on
- * most render variants. */
-#if defined(MCRT_INTEL_NO_VECTORIZE)
+/* Intel's CPU runtime (2026.2; the host defines MCRT_INTEL_CPU there) vectorises a kernel across
+ * work-items, and its vectoriser returns wrong values from any function it does not inline that
+ * returns a float3 (four lines show it: docs/ROBUSTNESS.md). With -D MCRT_INTEL_VECTORIZE
+ * (MCRT_KERNEL_OPTIONS) every function declared `inline` is inlined, and the vectorised kernels
+ * render PoCL's bits; but at 0.17-0.38 of the unvectorised kernels' samples per second on every
+ * variant measured (docs/BENCHMARKS.md, "Intel's OpenCL CPU runtime beside PoCL"): each lane
+ * fetches its own float4 nodes and triangle packets by gathers. So by default each work-item
+ * runs as scalar code there, as on PoCL. render.cl includes this header before any function. */
+#if defined(MCRT_INTEL_CPU) && defined(MCRT_INTEL_VECTORIZE)
+#define inline inline __attribute__((always_inline))
+#elif defined(MCRT_INTEL_CPU)
 #define kernel __kernel __attribute__((intel_vec_len_hint(1)))
 #endif
+#include "arithmetic.cl"
+
 #endif
 
 #ifndef __OPENCL_VERSION__

@@ -18,7 +18,8 @@ const std::vector<EnvironmentEntry> kEnvironment = {
     {kEnvKernelDir, "MCRT_KERNEL_DIR", "development",
      "read the kernel sources from this directory instead of the embedded copies"},
     {kEnvKernelOptions, "MCRT_KERNEL_OPTIONS", "development",
-     "extra build options for the render program (the stage profiler's -D switches)"},
+     "extra build options for the render program (the stage profiler's -D switches; "
+     "-D MCRT_INTEL_VECTORIZE vectorises kernels on Intel's runtime)"},
     {kEnvBuildChild, "MCRT_BUILD_CHILD", "development",
      "the executable that builds programs in a child process; empty: build in this process"},
     {kEnvSupervised, "MCRT_SUPERVISED", "internal",

@@ -10,6 +10,9 @@ independent, as Mitsuba's scene is mitsuba_reference.py's diffuse conversion):
   path        mcrt --estimator mis --mis-heuristic power --max-depth D --rr-depth 5 (D: --depth)
               ↔ `path`, max_depth D + 1, rr_depth 5 (mitsuba_reference.py's mapping)
 SCENE:sky renders a scene without emitters under --sky 1 in both (a `constant` emitter).
+--device SPEC renders mcrt's side on that device (mcrt render --device: an index, `pocl`,
+`intel`, ...; default mcrt's first device); Intel's OpenCL runtime is visible when the script
+runs under scripts/with-intel (Mitsuba uses no OpenCL).
 The light strategies still differ where the scene's lights do: Mitsuba picks an emitter (one
 mesh per emissive material) uniformly, then a point by area, mcrt a triangle by power (the same
 with one emissive material); Mitsuba samples the sky uniformly on the sphere, mcrt cosine-
@@ -40,7 +43,7 @@ Writes DIR/bench_vs_mitsuba.md (the table, also printed) and DIR/bench_vs_mitsub
 round's figures, machine, command, mcrt binary and commit, Mitsuba version).
 
 Usage: scripts/bench/bench_vs_mitsuba.py [--width 256 --height 256] [--spp 64] [--rounds 5] [--depth 8]
-           [--pairs mis,light-area,path] [--reference-spp 1024] [--mcrt BINARY]
+           [--pairs mis,light-area,path] [--reference-spp 1024] [--mcrt BINARY] [--device SPEC]
            --out DIR SCENE[:sky] ...
 """
 
@@ -65,14 +68,16 @@ RR_DEPTH = 5
 WARMUP_SEED, REFERENCE_SEED = 1000, 1000003  # apart from the rounds' seeds 0 .. 3R−1 (R < 333)
 
 
-def mcrt_options(pair, depth, sky):
-    """`mcrt render` options of a pair (without size, spp, seed)."""
+def mcrt_options(pair, depth, sky, device=None):
+    """`mcrt render` options of a pair (without size, spp, seed) on `device` (None: mcrt's
+    default)."""
     options = {"mis": ["--estimator", "mis", "--mis-heuristic", "power"],
                "light-area": ["--estimator", "light-area"],
                "path": ["--estimator", "mis", "--mis-heuristic", "power",
                         "--max-depth", depth, "--rr-depth", RR_DEPTH]}[pair]
     return options + ["--materials", "lambert", "--light-select", "power",
-                      "--sampler", "independent"] + (["--sky", "1"] if sky else [])
+                      "--sampler", "independent"] + (["--sky", "1"] if sky else []) + \
+        (["--device", device] if device else [])
 
 
 def mitsuba_integrator(pair, depth):
@@ -160,7 +165,7 @@ def bench(args, mi, item, pair, scratch):
     sky = tag == "sky"
     label = Path(scene).stem + ("-sky" if sky else "")
     pixels_spp = args.width * args.height * args.spp
-    options = mcrt_options(pair, args.depth, sky) + [
+    options = mcrt_options(pair, args.depth, sky, args.device) + [
         "--width", args.width, "--height", args.height, "--spp", args.spp]
     integrator = mitsuba_integrator(pair, args.depth)
     try:
@@ -173,13 +178,14 @@ def bench(args, mi, item, pair, scratch):
         raise mcrt_run.ScriptError("%s has no emitters: give it as %s:sky" % (scene, scene))
     depth = "-d%d" % args.depth if pair == "path" else ""
     ref, ref_variance, ref_path = cached_render(args, scene, "reference-%s-%s%s" % (
-        label, pair, depth), mcrt_options(pair, args.depth, sky))
+        label, pair, depth), mcrt_options(pair, args.depth, sky, args.device))
     # The pixels that see an emitter (the sky) directly: their pixel-jitter noise at a light's
     # edges, the same for every estimator, is nearly all of the squared error (99.7% on the
     # Cornell box at 64x64), so the RMSE of the table is that of the other pixels.
     emitted = cached_render(args, scene, "emitted-%s" % label,
                             ["--max-depth", 0, "--materials", "lambert"] +
-                            (["--sky", 1] if sky else []))[0]
+                            (["--sky", 1] if sky else []) +
+                            (["--device", args.device] if args.device else []))[0]
     # Dilated by a pixel: an edge pixel that the light covers a thousandth of is often missed
     # by the emitted render's 512 samples but hit by some 64-sample round (one such pixel of
     # veach-mis's radiance-3040 light made mcrt's RMSE 0.43 against its 0.05 elsewhere).
@@ -270,11 +276,14 @@ def table(rows, args, variant):
             r["rmse_mcrt"], r["rmse_mitsuba"], r["rmse_mcrt_at_mitsuba_time"],
             r["mcrt_surfaces_mean"], r["mitsuba_surfaces_mean"], difference))
     lines.append("")
-    lines.append("%dx%d, %d rounds; mcrt's time: seconds_render_wall of its stats. RMSE against a "
-                 "%d spp mcrt reference, its noise subtracted, over the pixels that see no "
-                 "emitter (nor one next to such a pixel); (…) mcrt's RMSE·√(t_mcrt/t_Mitsuba). "
-                 "Image means over the same pixels, ± the standard error from the rounds." % (
-                     args.width, args.height, args.rounds, args.reference_spp))
+    devices = sorted({r["mcrt_device"] for r in rows})
+    lines.append("mcrt on --device %s (%s); %dx%d, %d rounds; mcrt's time: seconds_render_wall "
+                 "of its stats. RMSE against a %d spp mcrt reference, its noise subtracted, over "
+                 "the pixels that see no emitter (nor one next to such a pixel); (…) mcrt's "
+                 "RMSE·√(t_mcrt/t_Mitsuba). Image means over the same pixels, ± the standard "
+                 "error from the rounds." % (
+                     args.device or "default", ", ".join(devices), args.width, args.height,
+                     args.rounds, args.reference_spp))
     return "\n".join(lines) + "\n"
 
 
@@ -302,6 +311,7 @@ def main():
     p.add_argument("--reference-spp", type=int, default=1024)
     p.add_argument("--variant", default="llvm_ad_rgb", help="Mitsuba variant")
     p.add_argument("--out", type=mcrt_run.output_directory, required=True, help="directory for the table, JSON, references")
+    p.add_argument("--device", help="mcrt's device (mcrt render --device SPEC; default its first)")
     mcrt_run.add_mcrt_option(p)
     args = p.parse_args()
     for name, value in (("--width", args.width), ("--height", args.height), ("--spp", args.spp),
@@ -337,7 +347,8 @@ def main():
         "python": sys.executable, "mcrt": os.path.abspath(mcrt), "mcrt_commit": git_revision(),
         "mitsuba_version": mi.__version__, "mitsuba_variant": args.variant,
         "width": args.width, "height": args.height, "spp": args.spp, "rounds": args.rounds,
-        "depth": args.depth, "reference_spp": args.reference_spp, "rows": rows},
+        "depth": args.depth, "device": args.device, "reference_spp": args.reference_spp,
+        "rows": rows},
         indent=1) + "\n")
     print(text)
 

@@ -11,7 +11,9 @@ ray's estimate by its normal, the store by a store nobody takes, the sample hash
 The stages assume the `mis` estimator with a Lambertian scene (--materials lambert), direct
 lighting, independent sampler: what `scripts/bench/bench_vs_mitsuba.py`'s mis pair renders.
 
-Usage: scripts/bench/profile_stages.py [--rounds 5] [--width 256 --height 256 --spp 64] [--mcrt BINARY] SCENE...
+Usage: scripts/bench/profile_stages.py [--rounds 5] [--width 256 --height 256 --spp 64] [--mcrt BINARY]
+           [--device SPEC] SCENE...
+(--device: mcrt render's; Intel's OpenCL runtime under scripts/with-intel.)
 Needs numpy (Debian's python3-numpy; /usr/bin/python3).
 """
 
@@ -33,10 +35,10 @@ STAGES = [
      "light_sample_pdf_w(&ls);",
      "        if (true) {\n            float pdf_light = light_sample_pdf_w(&ls);"),
     ("BSDF ray (closest hit and its surface point)", "estimators.cl",
-     "        if (trace_from(scene, sp, bs.wi, rays, &seen)) {\n            float3 Le = "
+     "        if (trace_bsdf_sample(scene, sp, &bs, rays, &seen)) {\n            float3 Le = "
      "emitted_radiance(&seen);",
-     "        if (as_uint(bs.wi.x) == 0x12345u && trace_from(scene, sp, bs.wi, rays, &seen)) {\n"
-     "            float3 Le = emitted_radiance(&seen);"),
+     "        if (as_uint(bs.wi.x) == 0x12345u && trace_bsdf_sample(scene, sp, &bs, rays, "
+     "&seen)) {\n            float3 Le = emitted_radiance(&seen);"),
     ("the estimator (light and BSDF sampling, both rays, MIS)", "path.cl",
      "        L += beta * MCRT_ESTIMATE(scene, &sp, stream, &record->rays);",
      "        L += beta * sp.n;"),
@@ -72,12 +74,14 @@ def main():
     p.add_argument("--width", type=int, default=256)
     p.add_argument("--height", type=int, default=256)
     p.add_argument("--spp", type=int, default=64)
+    p.add_argument("--device", help="mcrt render --device SPEC (default mcrt's first device)")
     mcrt_run.add_mcrt_option(p)
     args = p.parse_args()
     mcrt_run.require("numpy")
     binary = mcrt_run.mcrt_binary(args.mcrt)
     options = ["--width", args.width, "--height", args.height, "--spp", args.spp,
-               "--estimator", "mis", "--materials", "lambert"]
+               "--estimator", "mis", "--materials", "lambert"] + \
+        (["--device", args.device] if args.device else [])
     samples = args.width * args.height * args.spp
     print("| scene | stage left out | ns per sample without it, median (range) | the stage's "
           "cost, ns per sample | share of the sample |")
@@ -102,8 +106,9 @@ def main():
                     "—" if v[0] == "whole sample" else "%.1f" % cost,
                     "100%" if v[0] == "whole sample" else "%.0f%%" % (100 * cost / whole)))
     print()
-    print("%dx%d, %d spp, mis, --materials lambert; %d rounds alternating; kernel time per sample "
-          "(the stats' seconds_render)." % (args.width, args.height, args.spp, args.rounds))
+    print("%dx%d, %d spp, mis, --materials lambert, --device %s; %d rounds alternating; kernel "
+          "time per sample (the stats' seconds_render)." % (
+              args.width, args.height, args.spp, args.device or "default", args.rounds))
 
 
 if __name__ == "__main__":

@@ -716,7 +716,7 @@ def mitsuba_scene(mi, gltf, width, height, spp, scratch, max_depth=1, rr_depth=5
     allp = np.concatenate([c.positions.reshape(-1, 3) for parts in primitives.values() for c in parts])
     lo, hi = allp.min(axis=0), allp.max(axis=0)
     diag = float(np.linalg.norm(hi - lo))
-    if isinstance(camera, int):
+    if camera is None or isinstance(camera, int):  # the first camera node, or glTF camera K
         eye, forward, up, yfov = gltf.camera((lo, hi), camera)
     else:
         eye, target, up, fov = (np.asarray(v, np.float64) for v in camera)
