@@ -7,6 +7,7 @@
 #include <atomic>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <type_traits>
 #include <system_error>
@@ -134,7 +135,18 @@ double orientation_measure(double cos_o, double cos_e) {
     const double sin_o = std::sqrt(std::max(0.0, 1.0 - cos_o * cos_o));
     if (cos_e == 0.0) {
         if (cos_o >= 0.0) return 2.0 * kPi - kPi * cos_o + 0.5 * kPi * kPi * sin_o;
-        return 2.0 * kPi * (1.0 - cos_o) + kPi * (kPi - safe_acos(cos_o)) * sin_o;
+        // π − θ_o = acos(−cos θ_o) by Abramowitz & Stegun 4.4.46 (error ≤ 2e-8 rad): a cost,
+        // not a bound, needs no more.
+        const double x = std::min(1.0, -cos_o);
+        const double acos_x =
+            std::sqrt(1.0 - x) *
+            (1.5707963050 +
+             x * (-0.2145988016 +
+                  x * (0.0889789874 +
+                       x * (-0.0501743046 +
+                            x * (0.0308918810 +
+                                 x * (-0.0170881256 + x * (0.0066700901 - 0.0012624911 * x)))))));
+        return 2.0 * kPi * (1.0 - cos_o) + kPi * acos_x * sin_o;
     }
     double theta_o = safe_acos(cos_o), theta_e = safe_acos(cos_e);
     double theta_w = std::min(theta_o + theta_e, kPi);
@@ -204,7 +216,7 @@ void parallel_for(int threads, size_t n, Fn fn) {
 // most MCRT_LIGHT_TREE_MAX_DEPTH nodes deep.
 constexpr int kMaxBinaryDepth = 2 * MCRT_LIGHT_TREE_MAX_DEPTH;
 // Subtrees of more lights than this are built on a thread of their own while threads are free.
-constexpr size_t kParallelGrain = 8192;
+constexpr size_t kParallelGrain = 4096;
 // Splits of more than twice this many lights bin and partition in chunks of it, in parallel.
 constexpr size_t kChunk = size_t(1) << 16;
 // Splits of at most this many lights are found by a sweep, of more by the bins.
@@ -217,13 +229,14 @@ struct BinaryNode {
     uint32_t right = 0;
     uint32_t light = 0;  // leaf: its light
     bool leaf = false;
+    uint32_t wide_nodes = 0;  // the nodes of the four-wide tree this node would root
 };
 
 // Top-down binary build, depth first: the subtree over order[begin, end) of m lights takes the
 // 2m − 1 nodes from its index on, so that subtrees are built apart (in parallel) into places
 // fixed by the splits alone, and the tree is the same whatever the number of threads.
 struct BinaryBuilder {
-    const std::vector<Bounds>& items;
+    const Bounds* items;
     const std::vector<glm::dvec3>& centroid;
     std::vector<uint32_t>& order;  // items of the tree, permuted in place by the splits
     BinaryNode* nodes;  // storage for 2 · lights − 1, each constructed as its subtree is built
@@ -257,7 +270,25 @@ struct BinaryBuilder {
         if (given != nullptr) {
             all = *given;
         } else {
-            for (size_t i = begin; i < end; ++i) all.add(items[order[i]], centroid[order[i]]);
+            // The root: in fixed chunks, half of them on a free thread, merged in chunk order.
+            const size_t chunks = (end - begin + kChunk - 1) / kChunk;
+            std::vector<Side> parts(chunks);
+            auto take = [&](size_t from, size_t to) {
+                for (size_t c = from; c < to; ++c)
+                    for (size_t i = begin + c * kChunk; i < std::min(end, begin + (c + 1) * kChunk); ++i)
+                        parts[c].add(items[order[i]], centroid[order[i]]);
+            };
+            if (chunks > 1 && take_thread()) {
+                beside([&] { take(0, chunks / 2); }, [&] { take(chunks / 2, chunks); });
+                free_threads += 1;
+            } else {
+                take(0, chunks);
+            }
+            for (const Side& part : parts) {
+                all.bounds.add(part.bounds);
+                all.centroids.lo = glm::min(all.centroids.lo, part.centroids.lo);
+                all.centroids.hi = glm::max(all.centroids.hi, part.centroids.hi);
+            }
         }
         node.bounds = all.bounds;
         if (end - begin == 1) {
@@ -283,6 +314,15 @@ struct BinaryBuilder {
             build(begin, mid, left, depth + 1, &halves[0]);
             build(mid, end, right, depth + 1, &halves[1]);
         }
+        // As the root of a four-wide node: itself and the nodes below its inner slots.
+        uint32_t wide = 1;
+        for (uint32_t half : {left, right}) {
+            const BinaryNode& c = nodes[half];
+            if (c.leaf) continue;
+            for (uint32_t slot : {c.left, c.right})
+                if (!nodes[slot].leaf) wide += nodes[slot].wide_nodes;
+        }
+        node.wide_nodes = wide;
     }
 
     // The two sides of a cut at mid, in one pass.
@@ -524,12 +564,11 @@ gpu::LightTreeNode empty_node() {
 // Collapses the binary tree two levels to a node: slots 0, 1 from the first child (itself if a
 // leaf, else its two children), slots 2, 3 from the second, so that the kernels' first cut,
 // between the two pairs, is the binary split. Nodes are laid out depth first; each subtree's
-// node count is counted first, so that subtrees are written apart (in parallel) into places
-// fixed by the tree alone.
+// node count known from the binary build (BinaryNode::wide_nodes), subtrees are written apart
+// (in parallel) into places fixed by the tree alone.
 struct Collapser {
     const BinaryNode* binary;
     LightTree& out;
-    std::vector<uint32_t> count;  // per binary node collapsed into a node: that subtree's nodes
     std::atomic<int> free_threads;
 
     // The slots of the node that binary node b becomes.
@@ -544,17 +583,6 @@ struct Collapser {
             slots[2 * h + 1] = c.leaf ? 0u : c.right;
             n += c.leaf ? 1 : 2;
         }
-        return n;
-    }
-
-    uint32_t count_nodes(uint32_t b) {
-        uint32_t slots[4];
-        int used[4];
-        slots_of(b, slots, used);
-        uint32_t n = 1;
-        for (int k = 0; k < 4; ++k)
-            if (used[k] && !binary[slots[k]].leaf) n += count_nodes(slots[k]);
-        count[b] = n;
         return n;
     }
 
@@ -580,9 +608,9 @@ struct Collapser {
                 continue;
             }
             const uint32_t child = next, b = slots[k];
-            next += count[b];
+            next += binary[b].wide_nodes;
             set_slot(out.nodes[index], k, c.bounds, child, false);
-            if (count[b] > kParallelGrain && take_thread()) {
+            if (binary[b].wide_nodes > kParallelGrain && take_thread()) {
                 auto task = [=] {
                     collapse(b, child, slot_trail, depth + 1);
                     free_threads += 1;
@@ -622,18 +650,29 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
     // The lights with power in Morton order of their centroids (Morton 1966): a subtree's
     // lights then lie together in memory, which the splits' passes over them read in far fewer
     // cache lines.
+    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
     std::vector<glm::dvec3> centre(lights.size());
-    Bounds box;
+    std::mutex box_mutex;
+    Bounds box;  // of the centres (min and max: the same in any order)
+    parallel_for(threads, lights.size(), [&](size_t begin, size_t end) {
+        Bounds part;
+        for (size_t i = begin; i < end; ++i) {
+            if (!(powers[i] > 0.0)) continue;
+            glm::dvec3 p[3];
+            vertices(i, p);
+            centre[i] = 0.5 * (glm::min(p[0], glm::min(p[1], p[2])) +
+                               glm::max(p[0], glm::max(p[1], p[2])));
+            part.lo = glm::min(part.lo, centre[i]);
+            part.hi = glm::max(part.hi, centre[i]);
+        }
+        std::lock_guard<std::mutex> lock(box_mutex);
+        box.lo = glm::min(box.lo, part.lo);
+        box.hi = glm::max(box.hi, part.hi);
+    });
     std::vector<uint64_t> keys;
-    for (size_t i = 0; i < lights.size(); ++i) {
-        if (!(powers[i] > 0.0)) continue;
-        glm::dvec3 p[3];
-        vertices(i, p);
-        centre[i] = 0.5 * (glm::min(p[0], glm::min(p[1], p[2])) + glm::max(p[0], glm::max(p[1], p[2])));
-        box.lo = glm::min(box.lo, centre[i]);
-        box.hi = glm::max(box.hi, centre[i]);
-        keys.push_back(i);
-    }
+    keys.reserve(lights.size());
+    for (size_t i = 0; i < lights.size(); ++i)
+        if (powers[i] > 0.0) keys.push_back(i);
     if (keys.empty()) return tree;
     const glm::dvec3 extent = glm::max(box.hi - box.lo, glm::dvec3(1e-300));
     auto spread = [](uint32_t v) {  // the 10 bits of v, two zero bits between each
@@ -642,7 +681,6 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
         v = (v | (v << 4)) & 0x030C30C3u;
         return (v | (v << 2)) & 0x09249249u;
     };
-    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
     parallel_for(threads, keys.size(), [&](size_t begin, size_t end) {
         for (size_t k = begin; k < end; ++k) {
             const glm::dvec3 t = (centre[keys[k]] - box.lo) / extent * 1023.0;
@@ -659,7 +697,12 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
     }
     // Item k: the bounds of light light_of[k].
     const size_t count = keys.size();
-    std::vector<Bounds> items(count);
+    // Storage for the items, each constructed by the part that fills it (pages first touched
+    // in parallel).
+    using ItemStorage = std::aligned_storage_t<sizeof(Bounds), alignof(Bounds)>;
+    static_assert(std::is_trivially_destructible_v<Bounds>);
+    std::unique_ptr<ItemStorage[]> item_storage(new ItemStorage[count]);
+    Bounds* items = reinterpret_cast<Bounds*>(item_storage.get());
     std::vector<glm::dvec3> centroid(count);
     std::vector<uint32_t> light_of(count), order(count);
     parallel_for(threads, count, [&](size_t begin, size_t end) {
@@ -669,7 +712,7 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
             vertices(i, p);
             const glm::dvec3 normal = glm::cross(p[1] - p[0], p[2] - p[0]);
             const double length = glm::length(normal);
-            Bounds& b = items[k];
+            Bounds& b = *new (&items[k]) Bounds();
             b.lo = glm::min(p[0], glm::min(p[1], p[2]));
             b.hi = glm::max(p[0], glm::max(p[1], p[2]));
             b.phi = powers[i];
@@ -695,14 +738,14 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
         for (size_t i = begin; i < end; ++i)
             if (binary[i].leaf) binary[i].light = light_of[binary[i].light];
     });
-    Collapser collapser{binary, tree, std::vector<uint32_t>(binary_count, 0u), {threads - 1}};
+    Collapser collapser{binary, tree, {threads - 1}};
     if (binary[0].leaf) {  // one light: a root of one slot
         const uint32_t slots[4] = {0u, 0u, 0u, 0u};
         const int used[4] = {1, 0, 0, 0};
         tree.nodes.resize(1);
         collapser.place(slots, used, 0u, 0u, 0u);
     } else {
-        tree.nodes.resize(collapser.count_nodes(0u));
+        tree.nodes.resize(binary[0].wide_nodes);
         collapser.collapse(0u, 0u, 0u, 0u);
     }
     return tree;
