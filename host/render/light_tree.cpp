@@ -212,6 +212,23 @@ void parallel_for(int threads, size_t n, Fn fn) {
     for (std::thread& w : workers) w.join();
 }
 
+// The threads a build may still start beyond its own: taken before a thread starts, given back
+// when its work is done, so that work still running elsewhere can take it.
+class ThreadBudget {
+public:
+    explicit ThreadBudget(int spare) : spare_(spare) {}
+    bool take() {
+        int n = spare_.load();
+        while (n > 0)
+            if (spare_.compare_exchange_weak(n, n - 1)) return true;
+        return false;
+    }
+    void give_back() { spare_ += 1; }
+
+private:
+    std::atomic<int> spare_;
+};
+
 // Longest path of the binary tree, in edges: collapsed two levels to a node, its lights lie at
 // most MCRT_LIGHT_TREE_MAX_DEPTH nodes deep.
 constexpr int kMaxBinaryDepth = 2 * MCRT_LIGHT_TREE_MAX_DEPTH;
@@ -240,7 +257,7 @@ struct BinaryBuilder {
     const std::vector<glm::dvec3>& centroid;
     std::vector<uint32_t>& order;  // items of the tree, permuted in place by the splits
     BinaryNode* nodes;  // storage for 2 · lights − 1, each constructed as its subtree is built
-    std::atomic<int> free_threads;
+    ThreadBudget& budget;
 
     // The bins of one axis each: bounds (estimated cones) and counts.
     struct Bins {
@@ -278,9 +295,9 @@ struct BinaryBuilder {
                     for (size_t i = begin + c * kChunk; i < std::min(end, begin + (c + 1) * kChunk); ++i)
                         parts[c].add(items[order[i]], centroid[order[i]]);
             };
-            if (chunks > 1 && take_thread()) {
+            if (chunks > 1 && budget.take()) {
                 beside([&] { take(0, chunks / 2); }, [&] { take(chunks / 2, chunks); });
-                free_threads += 1;
+                budget.give_back();
             } else {
                 take(0, chunks);
             }
@@ -301,13 +318,13 @@ struct BinaryBuilder {
         node.left = index + 1;
         node.right = index + uint32_t(2 * (mid - begin));
         const uint32_t left = node.left, right = node.right;
-        if (mid - begin > kParallelGrain && end - mid > kParallelGrain && take_thread()) {
+        if (mid - begin > kParallelGrain && end - mid > kParallelGrain && budget.take()) {
             // The thread hands its place back as soon as its subtree is done, so that splits
             // still running elsewhere can take it.
             beside(
                 [=, &halves] {
                     build(begin, mid, left, depth + 1, &halves[0]);
-                    free_threads += 1;
+                    budget.give_back();
                 },
                 [=, &halves] { build(mid, end, right, depth + 1, &halves[1]); });
         } else {
@@ -373,12 +390,6 @@ struct BinaryBuilder {
         return begin + best_cut;
     }
 
-    bool take_thread() {
-        int n = free_threads.load();
-        while (n > 0)
-            if (free_threads.compare_exchange_weak(n, n - 1)) return true;
-        return false;
-    }
 
     // Where order[begin, end) is cut, with what is known of both sides in halves: the binned
     // SAOH's best bucket boundary, the sweep's best cut for few lights, or the median of the widest centroid axis when no bucket
@@ -430,9 +441,9 @@ struct BinaryBuilder {
                     for (size_t c = from; c < to; ++c)
                         bin(begin + c * kChunk, std::min(end, begin + (c + 1) * kChunk), parts[c]);
                 };
-                if (take_thread()) {
+                if (budget.take()) {
                     beside([&] { bin_chunks(0, chunks / 2); }, [&] { bin_chunks(chunks / 2, chunks); });
-                    free_threads += 1;
+                    budget.give_back();
                 } else {
                     bin_chunks(0, chunks);
                 }
@@ -482,9 +493,9 @@ struct BinaryBuilder {
                 auto side = [&](size_t from, size_t to, Side& out) {
                     for (size_t i = from; i < to; ++i) out.add(items[order[i]], centroid[order[i]]);
                 };
-                if (take_thread()) {
+                if (budget.take()) {
                     beside([&] { side(begin, mid, halves[0]); }, [&] { side(mid, end, halves[1]); });
-                    free_threads += 1;
+                    budget.give_back();
                 } else {
                     side(begin, mid, halves[0]);
                     side(mid, end, halves[1]);
@@ -569,7 +580,7 @@ gpu::LightTreeNode empty_node() {
 struct Collapser {
     const BinaryNode* binary;
     LightTree& out;
-    std::atomic<int> free_threads;
+    ThreadBudget& budget;
 
     // The slots of the node that binary node b becomes.
     int slots_of(uint32_t b, uint32_t* slots, int* used) const {
@@ -610,10 +621,10 @@ struct Collapser {
             const uint32_t child = next, b = slots[k];
             next += binary[b].wide_nodes;
             set_slot(out.nodes[index], k, c.bounds, child, false);
-            if (binary[b].wide_nodes > kParallelGrain && take_thread()) {
+            if (binary[b].wide_nodes > kParallelGrain && budget.take()) {
                 auto task = [=] {
                     collapse(b, child, slot_trail, depth + 1);
-                    free_threads += 1;
+                    budget.give_back();
                 };
                 try {
                     threads.emplace_back(task);
@@ -627,12 +638,6 @@ struct Collapser {
         for (std::thread& t : threads) t.join();
     }
 
-    bool take_thread() {
-        int n = free_threads.load();
-        while (n > 0)
-            if (free_threads.compare_exchange_weak(n, n - 1)) return true;
-        return false;
-    }
 };
 
 }  // namespace
@@ -732,13 +737,14 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
     static_assert(std::is_trivially_destructible_v<BinaryNode>);
     std::unique_ptr<Storage[]> storage(new Storage[binary_count]);  // not initialised
     BinaryNode* binary = reinterpret_cast<BinaryNode*>(storage.get());
-    BinaryBuilder builder{items, centroid, order, binary, {threads - 1}};
+    ThreadBudget budget(threads - 1);
+    BinaryBuilder builder{items, centroid, order, binary, budget};
     builder.build(0, order.size(), 0u, 0, nullptr);
     parallel_for(threads, binary_count, [&](size_t begin, size_t end) {
         for (size_t i = begin; i < end; ++i)
             if (binary[i].leaf) binary[i].light = light_of[binary[i].light];
     });
-    Collapser collapser{binary, tree, {threads - 1}};
+    Collapser collapser{binary, tree, budget};
     if (binary[0].leaf) {  // one light: a root of one slot
         const uint32_t slots[4] = {0u, 0u, 0u, 0u};
         const int used[4] = {1, 0, 0, 0};

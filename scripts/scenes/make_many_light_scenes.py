@@ -36,6 +36,20 @@ ROOT = Path(__file__).resolve().parents[2]
 BUNNY = ROOT.parent / "shared" / "scenes" / "stanford" / "bunny_zipper.glb"
 
 
+def tilted_normal(rng, max_tilt, up):
+    """A random tilt within max_tilt degrees of straight down (or up)."""
+    theta, phi = math.radians(max_tilt) * math.sqrt(rng.random()), 2.0 * math.pi * rng.random()
+    n = (math.sin(theta) * math.cos(phi), -math.cos(theta), math.sin(theta) * math.sin(phi))
+    return scale(n, -1.0) if up else n
+
+
+def lamp_triangle(c, n, size):
+    """A right triangle of legs `size` at c, counter-clockwise about n: (a, b) with a x b = n."""
+    a = normalize(cross(n, (1.0, 0.0, 0.0) if abs(n[0]) < 0.9 else (0.0, 0.0, 1.0)))
+    b = cross(n, a)
+    return [c, add(c, scale(a, size)), add(c, scale(b, size))]
+
+
 def lamp_field():
     g = StressScene("lamp-field")
     g.triangles("floor", quad((0.0, 0.0, 0.0), scale(Z, 34.0), scale(X, 34.0)),
@@ -47,17 +61,8 @@ def lamp_field():
         c = (rng.uniform(-16.0, 16.0), rng.uniform(1.0, 2.0), rng.uniform(-16.0, 16.0))
         up = rng.random() < 0.3
         level = rng.randrange(levels)
-        # A random tilt within 60 degrees of straight down (or up).
-        theta, phi = math.radians(60.0) * math.sqrt(rng.random()), 2.0 * math.pi * rng.random()
-        n = (math.sin(theta) * math.cos(phi), -math.cos(theta), math.sin(theta) * math.sin(phi))
-        if up:
-            n = scale(n, -1.0)
-        a = normalize(cross(n, (1.0, 0.0, 0.0) if abs(n[0]) < 0.9 else (0.0, 0.0, 1.0)))
-        b = cross(n, a)
-        size = rng.uniform(0.05, 0.15)
-        # Counter-clockwise about n: (a, b) with a x b = n.
-        points = [c, add(c, scale(a, size)), add(c, scale(b, size))]
-        groups.setdefault((up, level), []).extend(points)
+        n = tilted_normal(rng, 60.0, up)
+        groups.setdefault((up, level), []).extend(lamp_triangle(c, n, rng.uniform(0.05, 0.15)))
     parts = []
     for (up, level), points in sorted(groups.items()):
         L = 10.0 ** (3.0 * level / (levels - 1)) * (10.0 if up else 1.0)
@@ -82,14 +87,7 @@ def lamp_grid():
             c = (-5.75 + 0.5 * i, 1.0, -5.75 + 0.5 * j)
             up = rng.random() < 1.0 / 3.0
             level = rng.randrange(levels)
-            theta, phi = math.radians(45.0) * math.sqrt(rng.random()), 2.0 * math.pi * rng.random()
-            n = (math.sin(theta) * math.cos(phi), -math.cos(theta), math.sin(theta) * math.sin(phi))
-            if up:
-                n = scale(n, -1.0)
-            a = normalize(cross(n, (1.0, 0.0, 0.0) if abs(n[0]) < 0.9 else (0.0, 0.0, 1.0)))
-            b = cross(n, a)
-            size = 0.12
-            groups.setdefault(level, []).extend([c, add(c, scale(a, size)), add(c, scale(b, size))])
+            groups.setdefault(level, []).extend(lamp_triangle(c, tilted_normal(rng, 45.0, up), 0.12))
     parts = []
     for level, points in sorted(groups.items()):
         L = 10.0 ** (4.0 * level / (levels - 1))
