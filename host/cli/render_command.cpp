@@ -30,6 +30,7 @@
 #include "render/memory_estimate.h"
 #include "render/render_program.h"
 #include "render/renderer.h"
+#include "render/session.h"
 #include "cl/build_child.h"
 #include "render/variants.h"
 #include "scene/gltf_import.h"
@@ -93,7 +94,7 @@ std::string help_list(const char* what, const Table& table) {
 
 // Non-finite samples are counted as 0 (kernels/render.cl, reduce_chunks): say so, and refuse
 // an image that holds nothing else.
-void report_nonfinite_samples(uint64_t nonfinite, uint64_t samples) {
+void report_nonfinite_samples(uint64_t nonfinite, uint64_t samples, const WarningSink& warn) {
     if (nonfinite == 0 || samples == 0) return;
     const std::string count = std::to_string(nonfinite) + " of " + std::to_string(samples);
     if (nonfinite >= samples)
@@ -107,11 +108,39 @@ void report_nonfinite_samples(uint64_t nonfinite, uint64_t samples) {
         std::snprintf(share, sizeof share, "over 99.9%%");
     else
         std::snprintf(share, sizeof share, "%.1f%%", percent);
-    print_warning(count + " samples (" + share +
-                  ") were not finite (NaN or infinite) and were counted as 0");
+    if (warn)
+        warn(count + " samples (" + share +
+             ") were not finite (NaN or infinite) and were counted as 0");
 }
 
 }  // namespace
+
+void check_render_result(const RenderResult& result, const WarningSink& warn) {
+    const uint64_t samples = uint64_t(result.image.width) * uint64_t(result.image.height) * result.spp;
+    report_nonfinite_samples(result.nan_samples, samples, warn);
+    if (uint64_t bad = nonfinite_pixels(result.image))
+        throw RuntimeError(std::to_string(bad) +
+                           " pixels are not finite (radiance overflowed single "
+                           "precision); no image written");
+}
+
+std::map<std::string, std::string> exr_attributes(const RenderOptions& o,
+                                                  const RenderResult& result) {
+    return {
+        {"mcrt.scene", o.scene},
+        {"mcrt.estimator", o.estimator_file.empty() ? o.estimator : o.estimator_file},
+        {"mcrt.light_select", o.light_select},
+        {"mcrt.sampler", o.sampler},
+        {"mcrt.seed", std::to_string(o.seed)},
+        {"mcrt.mis_heuristic", o.mis_heuristic},
+        {"mcrt.materials", o.materials},
+        {"mcrt.replicates", std::to_string(result.replicates)},
+        {"mcrt.variance",
+         result.replicates > 1
+             ? "variance of the pixel mean from the spread of " + std::to_string(result.replicates) +
+                   " independent replicate means"
+             : "variance of the pixel mean: the samples' variance over their number"}};
+}
 
 RenderRequest render_request(const RenderOptions& o) {
     RenderRequest r;
@@ -252,8 +281,12 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     SceneSource source;
     source.files_read = &inputs;
     source.record = job ? &files : nullptr;
-    const PlannedRender planned = plan_render(request, source, print_warning);
-    const RenderPlan& plan = planned.plan;
+    // Settings are refused before the scene is read.
+    const RenderPlan checked = check_render_settings(request.settings, request.sky);
+    const std::shared_ptr<SessionScene> scene =
+        load_session_scene(request.scene, checked.settings.materials,
+                           checked.variants.light_select->id, source, print_warning);
+    const RenderPlan plan = plan_session_render(*scene, request, print_warning);
     const RenderSettings& settings = plan.settings;
     outputs.check_inputs(inputs);  // its buffers too
     check_host_memory("a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " render",
@@ -263,13 +296,7 @@ int render_here(const RenderOptions& o, RenderJob* job) {
         files.clear();
     }
 
-    std::vector<DeviceInfo> devices = select_devices(o.devices, print_warning);
-    std::vector<std::unique_ptr<DeviceContext>> contexts;
-    std::vector<const DeviceContext*> device_list;
-    for (const DeviceInfo& d : devices) {
-        contexts.push_back(std::make_unique<DeviceContext>(d));
-        device_list.push_back(contexts.back().get());
-    }
+    RenderSession session(select_devices(o.devices, print_warning));
 
     RenderControl control;
     control.time_limit = o.time_limit;
@@ -281,8 +308,8 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     ProgressBar bar(!o.quiet, uint64_t(o.width) * o.height);
     const double seconds_to_render =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    RenderResult result = render(
-        device_list, planned.scene.gpu, plan,
+    RenderResult result = session.render(
+        scene, plan,
         [&](uint32_t done, uint32_t total, const std::vector<DeviceReport>& d) {
             bar.update(done, total, d);
         },
@@ -292,27 +319,9 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     if (!result.stopped_by.empty())
         print_warning("stopped by " + result.stopped_by + " after " + std::to_string(result.spp) +
                       " of " + std::to_string(o.spp) + " samples per pixel; writing those");
+    check_render_result(result, print_warning);
 
-    report_nonfinite_samples(result.nan_samples, uint64_t(o.width) * o.height * result.spp);
-    if (uint64_t bad = nonfinite_pixels(result.image))
-        throw RuntimeError(std::to_string(bad) +
-                           " pixels are not finite (radiance overflowed single "
-                           "precision); no image written");
-
-    std::map<std::string, std::string> attributes = {
-        {"mcrt.scene", o.scene},
-        {"mcrt.estimator", o.estimator_file.empty() ? o.estimator : o.estimator_file},
-        {"mcrt.light_select", o.light_select},
-        {"mcrt.sampler", o.sampler},
-        {"mcrt.seed", std::to_string(o.seed)},
-        {"mcrt.mis_heuristic", o.mis_heuristic},
-        {"mcrt.materials", o.materials},
-        {"mcrt.replicates", std::to_string(result.replicates)},
-        {"mcrt.variance",
-         result.replicates > 1
-             ? "variance of the pixel mean from the spread of " + std::to_string(result.replicates) +
-                   " independent replicate means"
-             : "variance of the pixel mean: the samples' variance over their number"}};
+    const std::map<std::string, std::string> attributes = exr_attributes(o, result);
     test_pause("before-write");
     write_exr_to(outputs.temporary(o.out), o.out, result.image, attributes);
     if (!o.png.empty()) write_png_to(outputs.temporary(o.png), o.png, result.image, o.exposure);
@@ -320,7 +329,7 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!o.stats.empty()) {
         nlohmann::json j =
-            render_stats_json({o, planned, result, total, seconds_to_render});
+            render_stats_json({o, plan, scene->prepared, result, total, seconds_to_render});
         if (job) j["ranks"] = job->ranks_json(result.devices);
         errno = 0;
         std::ofstream out(outputs.temporary(o.stats), std::ios::trunc);

@@ -3,12 +3,14 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
 #include "cli/camera_options.h"
 #include "common/error.h"
 #include "render/plan.h"
+#include "render/renderer.h"
 #include "scene/scene.h"
 
 namespace mcrt {
@@ -48,5 +50,14 @@ RenderRequest render_request(const RenderOptions& o);
 
 // A setting the render library refused (SettingError), said with the command line's flag.
 InputError flag_error(const SettingError& e);
+
+// What a finished render must pass before it is written: its non-finite samples are told to
+// `warn` (counted as 0 by the kernels); throws RuntimeError when every sample, or any pixel, is
+// not finite.
+void check_render_result(const RenderResult& result, const WarningSink& warn);
+
+// The EXR header attributes of a render of these options (DESIGN.md "Outputs").
+std::map<std::string, std::string> exr_attributes(const RenderOptions& o,
+                                                  const RenderResult& result);
 
 }  // namespace mcrt

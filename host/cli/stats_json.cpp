@@ -20,11 +20,11 @@ uint64_t texel_bytes(const Scene& scene) {
 nlohmann::json render_stats_json(const RenderStatsInput& in) {
     const RenderOptions& o = in.options;
     const RenderResult& result = in.result;
-    const RenderSettings& settings = in.planned.plan.settings;
-    const Bvh& bvh = in.planned.scene.bvh;
-    const GpuSceneData& gpu_scene = in.planned.scene.gpu;
+    const RenderSettings& settings = in.plan.settings;
+    const Bvh& bvh = in.scene.bvh;
+    const GpuSceneData& gpu_scene = in.scene.gpu;
     uint64_t samples = uint64_t(o.width) * o.height * result.spp;
-    const unsigned uses = in.planned.plan.variants.estimator.uses;
+    const unsigned uses = in.plan.variants.estimator.uses;
     nlohmann::json j = {
         {"scene", o.scene},
         {"width", o.width},
@@ -66,15 +66,15 @@ nlohmann::json render_stats_json(const RenderStatsInput& in) {
         {"variance_estimate", result.replicates > 1 ? "replicates" : "samples"},
         {"variance_clamped", result.variance_clamped},
         {"nonfinite_pixels", 0},  // run_render writes no image with any
-        {"triangles", in.planned.scene.scene.triangle_count()},
+        {"triangles", in.scene.scene.triangle_count()},
         {"lights", gpu_scene.lights.size()},
-        {"seconds_scene_load", in.planned.scene.seconds_load},
+        {"seconds_scene_load", in.scene.seconds_load},
         // Texture data on each device: texels (4 bytes each) with the materials' slots and the
         // decode tables, and the triangles' texture coordinates and tangents.
         {"textures",
          {{"textured", gpu_scene.textured},
-          {"images", in.planned.scene.scene.images.size()},
-          {"texel_bytes", texel_bytes(in.planned.scene.scene)},
+          {"images", in.scene.scene.images.size()},
+          {"texel_bytes", texel_bytes(in.scene.scene)},
           {"device_bytes", gpu_scene.textures.size() * sizeof(uint32_t) +
                                gpu_scene.surfaces.size() * sizeof(gpu::TriangleSurface)}}},
         // The 4-wide tree the kernels traverse; the binary SAH tree it collapses as binary_*.

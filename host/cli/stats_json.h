@@ -14,7 +14,8 @@ namespace mcrt {
 
 struct RenderStatsInput {
     const RenderOptions& options;
-    const PlannedRender& planned;
+    const RenderPlan& plan;
+    const PreparedScene& scene;  // as the plan's render saw it
     const RenderResult& result;
     double seconds_total = 0;
     double seconds_to_render = 0;  // from the command's start to render(): load, BVH, upload

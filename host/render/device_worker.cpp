@@ -63,18 +63,37 @@ DeviceWorker::DeviceWorker(const DeviceContext& device, const GpuSceneData& scen
       fixed_batch_(plan.fixed_batch),
       fail_at_launch_(test_fault_launch(device.info.index)),
       slow_factor_(test_slow_factor(device.info.index)) {
-    report.name = device.info.name;
-    report.index = device.info.index;
-    const RenderSettings& settings = plan.settings;
     if (scene.light_selection != plan.variants.light_select->id)
         throw RuntimeError("the device scene holds the data of another light selection than " +
-                           settings.light_select + "'s");
+                           plan.settings.light_select + "'s");
+    build(plan);
+    buffers_ = std::make_unique<GpuSceneBuffers>(device, scene);
+    set_up(plan);
+}
 
-    cl::Program program = render_program(device, plan);
+DeviceWorker::DeviceWorker(const DeviceContext& device, const GpuSceneBuffers& scene,
+                           const RenderPlan& plan)
+    : device_(device),
+      settings_(plan.settings),
+      fixed_batch_(plan.fixed_batch),
+      fail_at_launch_(test_fault_launch(device.info.index)),
+      slow_factor_(test_slow_factor(device.info.index)) {
+    build(plan);
+    buffers_ = std::make_unique<GpuSceneBuffers>(scene);  // handles: the buffers are shared
+    set_up(plan);
+}
+
+void DeviceWorker::build(const RenderPlan& plan) {
+    report.name = device_.info.name;
+    report.index = device_.info.index;
+    cl::Program program = render_program(device_, plan);
     render_ = make_kernel(program, "render");
     reduce_ = make_kernel(program, "reduce_chunks");
-    buffers_ = std::make_unique<GpuSceneBuffers>(device, scene);
+}
 
+void DeviceWorker::set_up(const RenderPlan& plan) {
+    const DeviceContext& device = device_;
+    const RenderSettings& settings = plan.settings;
     // Batch buffers: at most 2^22 samples (64 MiB; a 150 ms launch needs far fewer on today's
     // devices) or a quarter of an allocation, whichever is less.
     max_samples_ =

@@ -29,6 +29,9 @@ class DeviceWorker : public RenderWorker {
     // The plan's fixed_batch > 0 makes every launch that many samples (--batch). `plan` must
     // outlive the worker.
     DeviceWorker(const DeviceContext& device, const GpuSceneData& scene, const RenderPlan& plan);
+    // The same on a scene already on the device (a session's, render/session.h): `scene` holds
+    // the light selection's buffer of the plan and the camera of the render.
+    DeviceWorker(const DeviceContext& device, const GpuSceneBuffers& scene, const RenderPlan& plan);
     // Waits for the commands still in flight: they write into this worker's host memory.
     ~DeviceWorker() override;
 
@@ -52,7 +55,9 @@ class DeviceWorker : public RenderWorker {
 private:
     // Makes the sums buffer hold `runs` ChunkSums, reallocating when it is smaller.
     void reserve_sums(uint64_t runs);
-
+    // The constructors' common part: the program, the batch buffers, the kernels' arguments.
+    void build(const RenderPlan& plan);
+    void set_up(const RenderPlan& plan);
 
   private:
     const DeviceContext& device_;

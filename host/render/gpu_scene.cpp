@@ -293,4 +293,16 @@ GpuSceneBuffers::GpuSceneBuffers(const DeviceContext& device, const GpuSceneData
     light_count = cl_uint(data.lights.size());
 }
 
+cl::Buffer upload_light_selection(const DeviceContext& device, const GpuSceneData& data,
+                                  cl_uint* tree_nodes) {
+    size_t bytes = 0;
+    *tree_nodes = 0;
+    return upload(device, light_selection_words(data, tree_nodes), bytes, "light selection data");
+}
+
+void write_camera(const DeviceContext& device, const GpuSceneBuffers& buffers,
+                  const gpu::CameraGpu& camera) {
+    CL_CHECK(device.queue.enqueueWriteBuffer(buffers.camera, CL_TRUE, 0, sizeof camera, &camera));
+}
+
 }  // namespace mcrt

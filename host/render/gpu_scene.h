@@ -69,4 +69,13 @@ struct GpuSceneBuffers {
     size_t bytes = 0;
 };
 
+// The light selection's buffer of `data` alone, for a device scene kept for several selections
+// (render/session.h); `tree_nodes` as light_selection_words sets it.
+cl::Buffer upload_light_selection(const DeviceContext& device, const GpuSceneData& data,
+                                  cl_uint* tree_nodes);
+
+// Writes the camera of a render into the device scene's camera buffer, waiting for the copy.
+void write_camera(const DeviceContext& device, const GpuSceneBuffers& buffers,
+                  const gpu::CameraGpu& camera);
+
 }  // namespace mcrt

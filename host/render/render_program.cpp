@@ -140,9 +140,13 @@ std::string read_estimator_file(const std::string& path) {
     std::ostringstream text;
     text << in.rdbuf();
     if (!in) throw SettingError("estimator_file", path + ": cannot read");
+    return check_estimator_source(path, text.str());
+}
+
+std::string check_estimator_source(const std::string& path, const std::string& source) {
     // Checked before any compiler sees it: includes, #line, NUL bytes, kernels, recursion,
     // private arrays (user_source.h); the text to compile has `#include "api.cl"` blanked.
-    UserSource checked = check_user_source(path, text.str(), kUserEstimatorFunction);
+    UserSource checked = check_user_source(path, source, kUserEstimatorFunction);
     // The kernel calls the user's function by name: say so before a compiler would, in mcrt's
     // own source, that it is missing.
     if (!checked.defines_function)

@@ -31,4 +31,8 @@ cl::Program render_program(const DeviceContext& device, const RenderPlan& plan);
 // or defines no `estimate` function.
 std::string read_estimator_file(const std::string& path);
 
+// The same for an estimator's text (`path` names it in messages and build errors): the text to
+// compile, or InputError / SettingError("estimator_file", ...) as read_estimator_file throws.
+std::string check_estimator_source(const std::string& path, const std::string& source);
+
 }  // namespace mcrt

@@ -151,6 +151,17 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
         build_light_selection(rebuilt, plan.variants.light_select->id);
         return render(devices, rebuilt, plan, progress, control, warn, remote);
     }
+    return render_with_workers(
+        devices,
+        [&](const DeviceContext& d) { return std::make_unique<DeviceWorker>(d, scene, plan); },
+        plan, progress, control, warn, remote);
+}
+
+RenderResult render_with_workers(const std::vector<const DeviceContext*>& devices,
+                                 const WorkerFactory& make_worker, const RenderPlan& plan,
+                                 const ProgressSink& progress, const RenderControl& control,
+                                 const std::function<void(const std::string&)>& warn,
+                                 const RemoteWorkers& remote) {
     const Activity activity("building the kernels and rendering");
     auto start = std::chrono::steady_clock::now();
     const RenderSettings& settings = plan.settings;
@@ -162,7 +173,7 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
     std::string last_error;
     for (const DeviceContext* d : devices) {
         try {
-            workers.push_back(std::make_unique<DeviceWorker>(*d, scene, plan));
+            workers.push_back(make_worker(*d));
         } catch (const RuntimeError& e) {
             if (devices.size() == 1 && !remote) throw;
             last_error = e.what();

@@ -87,6 +87,19 @@ struct RenderControl {
 
 struct RenderPlan;  // render/plan.h
 
+// One local device's worker for a render: a DeviceWorker that uploads the scene itself, or one
+// on a session's upload (render/session.h). Throws RuntimeError when the device cannot render.
+using WorkerFactory = std::function<std::unique_ptr<RenderWorker>(const DeviceContext&)>;
+
+// Renders the plan on the workers `make_worker` sets up on the devices, as render() below does
+// (render() is this with workers that upload the scene themselves).
+RenderResult render_with_workers(const std::vector<const DeviceContext*>& devices,
+                                 const WorkerFactory& make_worker, const RenderPlan& plan,
+                                 const ProgressSink& progress = {},
+                                 const RenderControl& control = {},
+                                 const std::function<void(const std::string&)>& warn = {},
+                                 const RemoteWorkers& remote = {});
+
 // Renders the plan on every device at once: work is handed out dynamically, each device's
 // launches sized to take about 150 ms; a device that fails is retired with a warning and its
 // work redone on the others. The image is bitwise identical whatever the devices, batch sizes

@@ -1,0 +1,96 @@
+// A render session: the devices, and what every render of a loaded scene shares, kept from one
+// render to the next. A scene is read, its BVH built and laid out for the devices once
+// (load_session_scene); a render of it plans its request (plan_session_render: the settings
+// checked, the camera chosen, the light selection's data built once per selection) and runs on
+// the session's devices, where the scene's buffers are uploaded at its first render and each
+// light selection's at the first render that uses it. Compiled programs are kept per process
+// (cl/program.h, cached_program). The command line renders through a session of one request;
+// the Python module (python/) keeps one per mcrt.Context.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "cl/device.h"
+#include "render/plan.h"
+#include "render/renderer.h"
+
+namespace mcrt {
+
+// A scene as loaded for a session's renders: read, its materials read as the materials variant
+// says, its BVH built and laid out for the devices.
+struct SessionScene {
+    std::string path;
+    std::string materials;  // a row of kMaterialVariants
+    // The camera is the scene's default (choose_camera) until a plan chooses one; the device
+    // layout holds the data of the light selection last planned.
+    PreparedScene prepared;
+    uint64_t id = 0;  // unique in the process: what a session's uploads are kept under
+    // Held by a caller that plans and renders the scene from several threads (the Python
+    // module): a plan changes the light selection's data and the camera.
+    std::mutex use;
+};
+
+// Reads `path` from `source` for renders with the materials variant `materials`; the device
+// layout is made for the light selection `selection`. Throws InputError for a scene that cannot
+// be read, SettingError for materials that name no variant; warnings of the import go to `warn`.
+std::shared_ptr<SessionScene> load_session_scene(const std::string& path,
+                                                 const std::string& materials,
+                                                 LightSelection selection,
+                                                 const SceneSource& source,
+                                                 const WarningSink& warn);
+
+// The plan of `request` for the loaded scene, as plan_render makes it: the settings checked
+// (SettingError), the camera chosen (SettingError) into scene.prepared.camera, the light
+// selection's data built on the host, the warnings of plan_render (no triangles, no lights for
+// an estimator that needs them). The request's materials must be the scene's.
+RenderPlan plan_session_render(SessionScene& scene, const RenderRequest& request,
+                               const WarningSink& warn);
+
+class RenderSession {
+  public:
+    // Opens a context and queue on each device, in the order given.
+    explicit RenderSession(const std::vector<DeviceInfo>& devices);
+    RenderSession(const RenderSession&) = delete;
+    RenderSession& operator=(const RenderSession&) = delete;
+
+    const std::vector<const DeviceContext*>& devices() const { return device_list_; }
+
+    // Renders the plan (plan_session_render of the same scene, the last one made) as render()
+    // does, on the scene's buffers kept on each device: uploaded at the scene's first render on
+    // the session, the light selection's at its first. One render at a time; the uploads of
+    // scenes no longer held elsewhere are released at the next render.
+    RenderResult render(const std::shared_ptr<SessionScene>& scene, const RenderPlan& plan,
+                        const ProgressSink& progress = {}, const RenderControl& control = {},
+                        const WarningSink& warn = {}, const RemoteWorkers& remote = {});
+
+    // Scenes whose buffers are on the devices now (tests: a released scene's are freed).
+    size_t uploaded_scenes() const;
+
+  private:
+    // One scene on one device: its buffers, with the light selection's buffer of each selection
+    // rendered so far.
+    struct DeviceUpload {
+        std::unique_ptr<GpuSceneBuffers> buffers;
+        struct Selection {
+            cl::Buffer buffer;
+            cl_uint tree_nodes = 0;
+        };
+        std::map<LightSelection, Selection> selections;
+    };
+    struct SceneUploads {
+        std::weak_ptr<SessionScene> scene;
+        std::map<int, DeviceUpload> devices;  // by device index
+    };
+
+    std::vector<std::unique_ptr<DeviceContext>> contexts_;
+    std::vector<const DeviceContext*> device_list_;
+    std::map<uint64_t, SceneUploads> uploads_;  // by SessionScene::id
+    mutable std::mutex mutex_;
+};
+
+}  // namespace mcrt
