@@ -44,6 +44,8 @@ def _number_text(name, value, kind):
         if not isinstance(value, _numbers.Integral):
             raise TypeError("%s: expected an int, got %s" % (name, type(value).__name__))
         return str(int(value))
+    if isinstance(value, _numbers.Integral):
+        return str(int(value))  # as written: the command line reads it as the same number
     value = float(value)
     # repr() is the shortest text that reads back as the same double: the parser's value.
     return "nan" if _math.isnan(value) else repr(value)
