@@ -75,7 +75,8 @@ def _arguments(options):
                 text = ",".join(_number_text(name, v, _FLOAT) for v in value)
         else:
             text = _number_text(name, value, kind)
-        args += [flag, text]
+        # One word, --flag=value: a value is never read as another option ("--seed").
+        args.append(flag + "=" + text)
     return args
 
 
