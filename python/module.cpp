@@ -219,6 +219,7 @@ PyResult render_scene(PyScene& self, const std::vector<std::string>& args,
     RenderControl control;
     control.time_limit = o.time_limit;
     control.interrupted = &interrupted;
+    control.keep_replicate_means = true;
     WarningSink warn = [&](const std::string& w) { data->warnings.push_back(w); };
 
     std::exception_ptr error;
@@ -275,6 +276,16 @@ py::array_t<float> image_view(const py::object& owner, const Image& image,
                               {py::ssize_t(sizeof(float)) * 3 * w, py::ssize_t(sizeof(float)) * 3,
                                py::ssize_t(sizeof(float))},
                               values.data(), owner);
+}
+
+// The replicates' mean images as (K, H, W, 3), a view on the result's floats, which hold them
+// pixel-major (Accumulator::replicate_means); None with one replicate.
+py::object replicate_view(const py::object& owner, const RenderResult& result) {
+    if (result.replicate_means.empty()) return py::none();
+    const py::ssize_t k = result.replicates, h = result.image.height, w = result.image.width;
+    const py::ssize_t f = sizeof(float);
+    return py::array_t<float>({k, h, w, py::ssize_t(3)}, {3 * f, 3 * k * w * f, 3 * k * f, f},
+                              result.replicate_means.data(), owner);
 }
 
 py::dict device_dict(const DeviceInfo& d) {
@@ -345,6 +356,11 @@ PYBIND11_MODULE(_mcrt, m) {
                                    const PyResult& r = self.cast<const PyResult&>();
                                    const Image& image = r.data->result.image;
                                    return image_view(self, image, image.variance);
+                               })
+        .def_property_readonly("replicate_images",
+                               [](py::object self) {
+                                   const PyResult& r = self.cast<const PyResult&>();
+                                   return replicate_view(self, r.data->result);
                                })
         .def_property_readonly("spp", [](const PyResult& r) { return r.data->result.spp; })
         .def_property_readonly("replicates",

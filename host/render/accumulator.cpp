@@ -79,6 +79,11 @@ uint32_t Accumulator::committed_spp() const {
     return std::min<uint64_t>(spp_, uint64_t(committed_chunks_) * MCRT_SAMPLES_PER_CHUNK);
 }
 
+std::vector<float> Accumulator::replicate_means() const {
+    if (replicates_ == 1) return {};
+    return std::vector<float>(mean_.begin(), mean_.end());
+}
+
 Image Accumulator::image(int width, int height) const {
     Image img(width, height);
     img.spp = committed_spp();

@@ -41,6 +41,9 @@ public:
     uint64_t roulette_ends() const { return roulette_ends_; }
     uint32_t replicates() const { return replicates_; }
     uint64_t variance_clamped() const { return variance_clamped_; }
+    // Each replicate's own mean image, pixel-major then replicate then channel:
+    // [(p · replicates + k) · 3 + c]; empty with one replicate.
+    std::vector<float> replicate_means() const;
 
 private:
     void apply(const BatchResult& r);

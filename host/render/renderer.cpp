@@ -339,6 +339,7 @@ RenderResult render_with_workers(const std::vector<const DeviceContext*>& device
     result.image = acc.image(settings.width, settings.height);
     result.nan_samples = acc.nan_samples();
     result.replicates = acc.replicates();
+    if (control.keep_replicate_means) result.replicate_means = acc.replicate_means();
     result.variance_clamped = acc.variance_clamped();
     result.rays = acc.rays();
     result.path_vertices = acc.path_vertices();

@@ -69,6 +69,9 @@ struct RenderResult {
     double seconds_build = 0;    // kernel compilation and scene upload
     double seconds_render_wall = 0;  // wall clock from the first launch to the last result
     double seconds_first_batch = 0;  // wall clock from render() to the first batch accumulated
+    // With RenderControl::keep_replicate_means and more than one replicate: each replicate's
+    // mean image, as Accumulator::replicate_means() orders it; else empty.
+    std::vector<float> replicate_means;
     std::vector<DeviceReport> devices;
 };
 
@@ -76,13 +79,17 @@ struct RenderResult {
 using ProgressSink =
     std::function<void(uint32_t done, uint32_t total, const std::vector<DeviceReport>& devices)>;
 
-// How a render may end early: a time limit (0 = none) and a flag set from a signal handler.
+// How a render may end early: a time limit (0 = none) and a flag set from a signal handler;
+// and what it keeps beside the image.
 struct RenderControl {
     double time_limit = 0;
     const volatile std::sig_atomic_t* interrupted = nullptr;
     // Called once when the kernels are about to run: after the builds and, in an MPI job, the
     // other ranks' setup (the supervisor's time limit counts from here, host/cli/supervisor.h).
     std::function<void()> launching;
+    // Keep each replicate's mean image (RenderResult::replicate_means): the Python module's
+    // Result.replicate_images; the command line writes none.
+    bool keep_replicate_means = false;
 };
 
 struct RenderPlan;  // render/plan.h

@@ -137,6 +137,20 @@ def test_result_fields_and_stats(cornell):
     assert info["triangles"] == s["triangles"] and info["emitters"] > 0
 
 
+def test_replicate_images_are_the_replicates_means(cornell):
+    r = cornell.render(sampler="sobol", replicates=4, **SMALL)
+    reps = r.replicate_images
+    assert reps.shape == (4, 24, 24, 3) and not reps.flags.owndata
+    assert np.shares_memory(reps, r.replicate_images)
+    # The image is their mean, the variance their spread over K (K - 1) (render/accumulator.h),
+    # each rounded once to float from double.
+    mean = reps.astype(np.float64).mean(axis=0)
+    assert np.allclose(r.image, mean, rtol=1e-5, atol=1e-7)
+    spread = ((reps - mean) ** 2).sum(axis=0) / (4 * 3)
+    assert np.allclose(r.variance, spread, rtol=1e-3, atol=1e-9)
+    assert cornell.render(replicates=1, **SMALL).replicate_images is None
+
+
 def test_save_writes_png(cornell, tmp_path):
     r = cornell.render(**SMALL)
     r.save(str(tmp_path / "a.exr"), png=str(tmp_path / "a.png"))
