@@ -22,9 +22,10 @@ MCRT_EXE = os.environ.get("MCRT_EXE", str(ROOT / "build" / "mcrt"))
 SMALL = dict(width=24, height=24, spp=16)
 
 
-def cli_error(*args):
+def cli_error(*args, env=None):
     """The one line `mcrt render` prints for an error, without "mcrt: error: "."""
-    run = subprocess.run([MCRT_EXE, "render", *args], capture_output=True, text=True)
+    run = subprocess.run([MCRT_EXE, "render", *args], capture_output=True, text=True,
+                         env=None if env is None else dict(os.environ, **env))
     assert run.returncode != 0, run.stderr
     lines = [l for l in run.stderr.splitlines() if l.startswith("mcrt: error: ")]
     assert lines, run.stderr
@@ -245,6 +246,17 @@ def test_device_errors(tmp_path):
     assert isinstance(e.value, RuntimeError) and "closed" in str(e.value)
     with pytest.raises(mcrt.DeviceError):
         c.load(CORNELL)
+
+
+def test_a_failing_device_is_a_device_error(cornell, monkeypatch):
+    # The test hook fails device 0's first launch (common/test_hooks.h): no device is left.
+    monkeypatch.setenv("MCRT_FAULT_INJECT", "0:1")
+    with pytest.raises(mcrt.DeviceError) as e:
+        cornell.render(**SMALL)
+    assert str(e.value) == cli_error(CORNELL, "--out", "/tmp/unused.exr", "--width", "24",
+                                     "--height", "24", env={"MCRT_FAULT_INJECT": "0:1"})
+    monkeypatch.delenv("MCRT_FAULT_INJECT")
+    assert cornell.render(**SMALL).spp == 16
 
 
 # Threads, interruption, memory.
