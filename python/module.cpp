@@ -25,7 +25,7 @@
 #include "common/error.h"
 #include "image/image.h"
 #include "render/memory_estimate.h"
-#include "render/render_program.h"
+#include "render/estimator_file.h"
 #include "render/session.h"
 #include "render/variants.h"
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "render/render_program.h"
+#include "render/estimator_file.h"
 #include "render/renderer.h"
 
 namespace mcrt::test {

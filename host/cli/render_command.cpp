@@ -28,6 +28,7 @@
 #include "image/image_check.h"
 #include "mpi/job.h"
 #include "render/memory_estimate.h"
+#include "render/estimator_file.h"
 #include "render/render_program.h"
 #include "render/renderer.h"
 #include "render/session.h"

@@ -1,5 +1,6 @@
 // The render program of a render's plan: its -D options (RenderPlan::program_options), a user's
-// estimator file in place of kernels/user_estimator.cl, and its build on one device.
+// estimator file in place of kernels/user_estimator.cl (checked by render/estimator_file.h), and
+// its build on one device.
 #pragma once
 
 #include <CL/opencl.hpp>
@@ -26,13 +27,5 @@ KernelReplacements render_program_replacements(const RenderSettings& settings);
 // estimator file throws InputError whose first line names FILE:LINE and the compiler's message,
 // followed by the build log; any other build failure throws RuntimeError with the log.
 cl::Program render_program(const DeviceContext& device, const RenderPlan& plan);
-
-// The text of a user's estimator file; throws InputError when it is not a readable regular file
-// or defines no `estimate` function.
-std::string read_estimator_file(const std::string& path);
-
-// The same for an estimator's text (`path` names it in messages and build errors): the text to
-// compile, or InputError / SettingError("estimator_file", ...) as read_estimator_file throws.
-std::string check_estimator_source(const std::string& path, const std::string& source);
 
 }  // namespace mcrt
