@@ -329,3 +329,22 @@ def test_repeated_renders_do_not_grow_memory(cornell):
         assert r.image.shape == (16, 16, 3)
     grown = rss_bytes() - before
     assert grown < 50 * 2 ** 20, "RSS grew by %.1f MB over 200 renders" % (grown / 2 ** 20)
+
+
+def test_repeated_errors_do_not_grow_memory(ctx, cornell, tmp_path):
+    def errors():
+        for call in (lambda: cornell.render(spp=0),
+                     lambda: cornell.render(fov=float("nan"), look_from=(0, 1, 3),
+                                            look_at=(0, 1, 0)),
+                     lambda: ctx.load(str(tmp_path / "nosuch.gltf")),
+                     lambda: ctx.estimator("not OpenCL", name="bad.cl")):
+            with pytest.raises(ValueError):
+                call()
+
+    for _ in range(20):
+        errors()
+    before = rss_bytes()
+    for _ in range(200):
+        errors()
+    grown = rss_bytes() - before
+    assert grown < 5 * 2 ** 20, "RSS grew by %.1f MB over 800 errors" % (grown / 2 ** 20)
