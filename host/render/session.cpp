@@ -70,9 +70,20 @@ RenderPlan plan_session_render(SessionScene& scene, const RenderRequest& request
     return finish_render_plan(std::move(plan), prepared.gpu);
 }
 
+std::shared_ptr<DeviceContext> process_device_context(const DeviceInfo& device) {
+    static std::mutex mutex;
+    // Never destroyed: a context lives as long as the programs cached_program keeps on it, the
+    // life of the process.
+    static auto* contexts = new std::map<cl_device_id, std::shared_ptr<DeviceContext>>();
+    std::lock_guard<std::mutex> lock(mutex);
+    std::shared_ptr<DeviceContext>& context = (*contexts)[device.device()];
+    if (!context) context = std::make_shared<DeviceContext>(device);
+    return context;
+}
+
 RenderSession::RenderSession(const std::vector<DeviceInfo>& devices) {
     for (const DeviceInfo& d : devices) {
-        contexts_.push_back(std::make_unique<DeviceContext>(d));
+        contexts_.push_back(process_device_context(d));
         device_list_.push_back(contexts_.back().get());
     }
 }

@@ -51,9 +51,15 @@ std::shared_ptr<SessionScene> load_session_scene(const std::string& path,
 RenderPlan plan_session_render(SessionScene& scene, const RenderRequest& request,
                                const WarningSink& warn);
 
+// The process's one context and in-order queue on the device, made at the first call. Sessions
+// share them: cached_program keeps each program built for a context for the life of the process,
+// so a context per session would build every variant again, and keep it, for each new session.
+std::shared_ptr<DeviceContext> process_device_context(const DeviceInfo& device);
+
 class RenderSession {
   public:
-    // Opens a context and queue on each device, in the order given.
+    // Renders on the devices, in the order given, through the process's context and queue of
+    // each (process_device_context).
     explicit RenderSession(const std::vector<DeviceInfo>& devices);
     RenderSession(const RenderSession&) = delete;
     RenderSession& operator=(const RenderSession&) = delete;
@@ -87,7 +93,7 @@ class RenderSession {
         std::map<int, DeviceUpload> devices;  // by device index
     };
 
-    std::vector<std::unique_ptr<DeviceContext>> contexts_;
+    std::vector<std::shared_ptr<DeviceContext>> contexts_;
     std::vector<const DeviceContext*> device_list_;
     std::map<uint64_t, SceneUploads> uploads_;  // by SessionScene::id
     mutable std::mutex mutex_;

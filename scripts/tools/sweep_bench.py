@@ -1,9 +1,10 @@
 #!/usr/bin/python3
-"""Times one sweep of variants three ways, after one untimed pass of each so that all find
-PoCL's kernel cache warm: with the Python module in a new context (the scene loaded once, each
-variant's program loaded once), again in a context that has rendered every variant before (a
-second sweep of a session), and as a loop of `mcrt render` commands. Checks that they give the
-same images, and prints the times and the ratios (docs/PYTHON.md).
+"""Times one sweep of variants three ways, after one untimed pass so that all find PoCL's
+kernel cache warm: a new Python process that imports the module, loads the scene once and
+renders every variant (each variant's program loaded from PoCL's cache once); the same sweep
+again in a context that has rendered every variant before (programs and uploads kept); and a
+loop of `mcrt render` commands. Checks that the three give the same images, and prints the
+times and the ratios (docs/PYTHON.md).
 
     PYTHONPATH=build/python scripts/tools/sweep_bench.py [--scene S.gltf] [--mcrt build/mcrt]
         [--size 64] [--spp 4] [--estimators light-area,light-solid-angle,bsdf,mis]
@@ -11,6 +12,7 @@ same images, and prints the times and the ratios (docs/PYTHON.md).
 """
 
 import argparse
+import os
 import statistics
 import subprocess
 import sys
@@ -28,7 +30,7 @@ from mcrt_exr import read_exr  # noqa: E402
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def main():
+def parse():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--scene", default=str(ROOT / "scenes" / "cornell" /
                                                "CornellBox-Original.gltf"))
@@ -38,17 +40,29 @@ def main():
     parser.add_argument("--estimators", default="light-area,light-solid-angle,bsdf,mis")
     parser.add_argument("--selections", default="uniform,power,tree")
     parser.add_argument("--repeats", type=int, default=3)
-    args = parser.parse_args()
+    parser.add_argument("--child", help=argparse.SUPPRESS)  # the new process: its images' file
+    return parser.parse_args()
+
+
+def sweep(scene, args):
     variants = [(e, s) for e in args.estimators.split(",") for s in args.selections.split(",")]
-    common = dict(width=args.size, height=args.size, spp=args.spp, max_depth=2)
+    return [scene.render(estimator=e, light_select=s, width=args.size, height=args.size,
+                         spp=args.spp, max_depth=2).image.copy() for e, s in variants]
 
-    def sweep(scene):
-        return [scene.render(estimator=e, light_select=s, **common).image.copy()
-                for e, s in variants]
 
-    def in_process():
+def main():
+    args = parse()
+    if args.child:
         with mcrt.Context() as ctx:
-            return sweep(ctx.load(args.scene))
+            np.save(args.child, np.stack(sweep(ctx.load(args.scene), args)))
+        return 0
+    variants = [(e, s) for e in args.estimators.split(",") for s in args.selections.split(",")]
+
+    def new_process(out_dir):
+        images = str(Path(out_dir) / "images.npy")
+        subprocess.run([sys.executable, __file__, "--child", images] + sys.argv[1:], check=True,
+                       env=dict(os.environ))
+        return list(np.load(images))
 
     def cli_loop(out_dir):
         images = []
@@ -70,24 +84,24 @@ def main():
     kept = mcrt.Context()
     kept_scene = kept.load(args.scene)
     with tempfile.TemporaryDirectory() as out_dir:
-        sweep(kept_scene), cli_loop(out_dir)  # untimed: PoCL's cache holds every variant
-        module_times, kept_times, cli_times = [], [], []
+        sweep(kept_scene, args), cli_loop(out_dir)  # untimed: PoCL's cache holds every variant
+        fresh_times, kept_times, cli_times = [], [], []
         for _ in range(args.repeats):
-            t, module_images = timed(in_process)
-            module_times.append(t)
-            t, kept_images = timed(sweep, kept_scene)
+            t, fresh_images = timed(new_process, out_dir)
+            fresh_times.append(t)
+            t, kept_images = timed(sweep, kept_scene, args)
             kept_times.append(t)
             t, cli_images = timed(cli_loop, out_dir)
             cli_times.append(t)
     same = all(np.array_equal(a, b) and np.array_equal(a, k)
-               for a, b, k in zip(module_images, cli_images, kept_images))
-    m, k, c = (statistics.median(t) for t in (module_times, kept_times, cli_times))
+               for a, b, k in zip(fresh_images, cli_images, kept_images))
+    f, k, c = (statistics.median(t) for t in (fresh_times, kept_times, cli_times))
     print("%d variants, %dx%d, %d spp, %s; median of %d" % (
         len(variants), args.size, args.size, args.spp, Path(args.scene).name, args.repeats))
-    print("module, new context (load, every program, every render): %7.3f s" % m)
-    print("module, the context of an earlier sweep:                 %7.3f s" % k)
-    print("mcrt render loop:                                        %7.3f s" % c)
-    print("ratios %.1fx and %.1fx; images %s" % (c / m, c / k, "identical" if same else "DIFFER"))
+    print("mcrt render loop:                                          %7.3f s" % c)
+    print("module, a new process (import, load, programs, renders):   %7.3f s  %5.1fx" % (f, c / f))
+    print("module, a context that rendered the variants before:       %7.3f s  %5.1fx" % (k, c / k))
+    print("images %s" % ("identical" if same else "DIFFER"))
     return 0 if same else 1
 
 

@@ -348,3 +348,14 @@ def test_repeated_errors_do_not_grow_memory(ctx, cornell, tmp_path):
         errors()
     grown = rss_bytes() - before
     assert grown < 5 * 2 ** 20, "RSS grew by %.1f MB over 800 errors" % (grown / 2 ** 20)
+
+
+def test_one_shot_renders_share_the_process_programs():
+    # Each mcrt.render is a new Context: on the process's device contexts, so that its programs
+    # are those built before, not built (and kept) again.
+    mcrt.render(CORNELL, width=16, height=16)
+    before = rss_bytes()
+    for _ in range(30):
+        mcrt.render(CORNELL, width=16, height=16)
+    grown = rss_bytes() - before
+    assert grown < 20 * 2 ** 20, "RSS grew by %.1f MB over 30 one-shot renders" % (grown / 2 ** 20)
