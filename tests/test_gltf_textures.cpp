@@ -48,6 +48,9 @@ struct TexturedGltf {
     std::string samplers;  // no "samplers" when empty
     std::string extra;     // more top-level properties, each followed by a comma
     size_t primitives = 1;
+    // The attributes of primitive k where given (its entry not empty), else all three.
+    std::vector<std::string> attributes;
+    std::vector<size_t> material_of;  // primitive k's material where given, else material k
     Bytes embedded;  // bytes after the geometry, as bufferView 4 (an image's)
 
     std::string text() const {
@@ -66,10 +69,13 @@ struct TexturedGltf {
                      std::to_string(embedded.size()) + "}";
         std::string prims;
         for (size_t k = 0; k < primitives; ++k) {
-            prims += std::string(k ? ", " : "") +
-                     R"({"attributes": {"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 2},
-                         "indices": 3, "material": )" +
-                     std::to_string(k) + "}";
+            const std::string attributes_k =
+                k < attributes.size() && !attributes[k].empty()
+                    ? attributes[k]
+                    : R"("POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 2)";
+            prims += std::string(k ? ", " : "") + R"({"attributes": {)" + attributes_k +
+                     R"(}, "indices": 3, "material": )" +
+                     std::to_string(k < material_of.size() ? material_of[k] : k) + "}";
         }
         return R"({"asset": {"version": "2.0"}, )" + extra +
                R"("scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
@@ -282,6 +288,114 @@ TEST_CASE("texCoord 0 and 1 are read; other sets are refused", "[gltf][textures]
     g.materials = R"([{"emissiveTexture": {"index": 0, "texCoord": -1}}])";
     CHECK(contains(refusal(g), "materials[0].emissiveTexture.texCoord: expected an integer from 0 "
                                "to 2147483647, found -1"));
+}
+
+TEST_CASE("a texture on a TEXCOORD_n the primitive lacks is ignored there, with one warning",
+          "[gltf][textures]") {
+    // glTF 2.0 "Texture Data": a primitive MUST have the set its material's textures read. Read
+    // anyway, every corner would sample texel (0, 0).
+    TexturedGltf g;
+    g.attributes = {R"("POSITION": 0, "TEXCOORD_0": 1)"};  // no TEXCOORD_1
+    SECTION("each slot, its factor kept") {
+        const struct {
+            const char* material;
+            const char* slot;
+            TextureRef Material::*ref;
+        } slots[] = {
+            {R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1},
+                 "baseColorFactor": [0.5, 0.25, 1, 1]}})",
+             "baseColorTexture", &Material::base_color_texture},
+            {R"({"pbrMetallicRoughness": {"metallicRoughnessTexture": {"index": 0, "texCoord": 1},
+                 "baseColorFactor": [0.5, 0.25, 1, 1]}})",
+             "metallicRoughnessTexture", &Material::metallic_roughness_texture},
+            {R"({"normalTexture": {"index": 0, "texCoord": 1},
+                 "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 1, 1]}})",
+             "normalTexture", &Material::normal_texture},
+            {R"({"emissiveTexture": {"index": 0, "texCoord": 1}, "emissiveFactor": [1, 1, 1],
+                 "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 1, 1]}})",
+             "emissiveTexture", &Material::emissive_texture},
+        };
+        for (const auto& slot : slots) {
+            INFO(slot.slot);
+            g.materials = std::string("[") + slot.material + "]";
+            const Loaded l = load(g);
+            REQUIRE(l.warnings.size() == 1);
+            CHECK(contains(l.warnings[0], "textured.gltf: mesh 0 primitive 0: lacks the texture "
+                                          "coordinates that material 0 reads for " +
+                                              std::string(slot.slot) + " (TEXCOORD_1); ignored"));
+            REQUIRE(l.scene.triangle_material.size() == 1);
+            const Material& m = l.scene.materials[l.scene.triangle_material[0]];
+            CHECK_FALSE((m.*slot.ref).used());
+            CHECK(m.albedo == glm::vec3(0.5f, 0.25f, 1.0f));
+        }
+    }
+    SECTION("through KHR_texture_transform's texCoord, both ways") {
+        g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 0,
+                           "extensions": {"KHR_texture_transform": {"texCoord": 1}}}}}])";
+        Loaded l = load(g);
+        REQUIRE(l.warnings.size() == 1);
+        CHECK(contains(l.warnings[0], "baseColorTexture (TEXCOORD_1)"));
+        CHECK_FALSE(l.scene.materials[l.scene.triangle_material[0]].base_color_texture.used());
+        // The override names a set the primitive has: the texture stays.
+        g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1,
+                           "extensions": {"KHR_texture_transform": {"texCoord": 0}}}}}])";
+        l = load(g);
+        CHECK(l.warnings.empty());
+        CHECK(l.scene.materials[l.scene.triangle_material[0]].base_color_texture.used());
+    }
+    SECTION("a primitive without any texture coordinates, several slots named at once") {
+        g.attributes = {R"("POSITION": 0)"};
+        g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
+                           "normalTexture": {"index": 0}, "name": "Floor"}])";
+        const Loaded l = load(g);
+        REQUIRE(l.warnings.size() == 1);
+        CHECK(contains(l.warnings[0], "material 0 (\"Floor\") reads for baseColorTexture "
+                                      "(TEXCOORD_0), normalTexture (TEXCOORD_0); ignored"));
+        const Material& m = l.scene.materials[l.scene.triangle_material[0]];
+        CHECK_FALSE(m.base_color_texture.used());
+        CHECK_FALSE(m.normal_texture.used());
+        CHECK(m.name == "Floor");
+    }
+    SECTION("one material on primitives with and without the set: each sees its own") {
+        g.primitives = 3;
+        g.material_of = {0, 0, 0};
+        g.attributes = {"", R"("POSITION": 0, "TEXCOORD_0": 1)", R"("POSITION": 0)"};
+        g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}}}])";
+        const Loaded l = load(g);
+        REQUIRE(l.warnings.size() == 1);  // one warning for both primitives
+        CHECK(contains(l.warnings[0], "mesh 0 primitive 1: lacks"));
+        CHECK(contains(l.warnings[0], "; the same on 1 more primitive(s)"));
+        REQUIRE(l.scene.triangle_material.size() == 3);
+        CHECK(l.scene.materials[l.scene.triangle_material[0]].base_color_texture.used());
+        CHECK_FALSE(l.scene.materials[l.scene.triangle_material[1]].base_color_texture.used());
+        // The copy without the texture is made once, and shared.
+        CHECK(l.scene.materials.size() == 2);
+        CHECK(l.scene.triangle_material[2] == l.scene.triangle_material[1]);
+        CHECK(l.scene.images.size() == 1);
+    }
+    SECTION("instances of one primitive are one primitive in the warning") {
+        g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}}}])";
+        std::string text = g.text();
+        for (const auto& [from, to] :
+             {std::pair<std::string, std::string>{R"("scenes": [{"nodes": [0]}])", R"("scenes": [{"nodes": [0, 1]}])"},
+              {R"("nodes": [{"mesh": 0}])", R"("nodes": [{"mesh": 0}, {"mesh": 0, "translation": [0, 0, 1]}])"}}) {
+            const size_t at = text.find(from);
+            REQUIRE(at != std::string::npos);
+            text.replace(at, from.size(), to);
+        }
+        std::vector<std::string> warnings;
+        const Scene scene = load_gltf_from_memory("textured.gltf", Bytes(text.begin(), text.end()),
+                                                  [&](const std::string& w) { warnings.push_back(w); });
+        CHECK(scene.triangle_count() == 2);
+        REQUIRE(warnings.size() == 1);
+        CHECK_FALSE(contains(warnings[0], "more primitive"));
+    }
+    SECTION("an occlusion texture on a missing set: only the occlusion warning (it is not read)") {
+        g.materials = R"([{"occlusionTexture": {"index": 0, "texCoord": 1}}])";
+        const Loaded l = load(g);
+        REQUIRE(l.warnings.size() == 1);
+        CHECK(contains(l.warnings[0], "occlusionTexture is not used"));
+    }
 }
 
 TEST_CASE("KHR_texture_transform: T(offset) R(rotation) S(scale) and its texCoord, on every slot",
