@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <zlib.h>
+
 #include "common/error.h"
 #include "image_bytes.h"
 #include "scene/gltf_images.h"
@@ -168,6 +170,51 @@ Bytes baseline_jpeg(int width, int height, const Bytes& texels) {
         },
         &out, width, height, 3, texels.data(), 100);
     return out;
+}
+
+// A PNG of `width` × `height` texels whose IDAT holds `stream` as it is (a zlib stream, valid or
+// not; CRCs right), `chunks` between IHDR and IDAT.
+Bytes png_with_stream(uint32_t width, uint32_t height, uint8_t depth, uint8_t colour_type,
+                      const Bytes& stream, const std::vector<Bytes>& chunks = {},
+                      bool interlaced = false) {
+    Bytes png = png_signature();
+    Bytes ihdr = png_ihdr(width, height, depth, colour_type);
+    if (interlaced) {  // the interlace byte, and the CRC again
+        ihdr[8 + 12] = 1;
+        Bytes data(ihdr.begin() + 8, ihdr.begin() + 21);
+        ihdr = png_chunk("IHDR", data);
+    }
+    for (const Bytes& chunk : std::vector<Bytes>{ihdr})
+        png.insert(png.end(), chunk.begin(), chunk.end());
+    for (const Bytes& chunk : chunks) png.insert(png.end(), chunk.begin(), chunk.end());
+    for (const Bytes& chunk : {png_chunk("IDAT", stream), png_chunk("IEND", {})})
+        png.insert(png.end(), chunk.begin(), chunk.end());
+    return png;
+}
+
+// `raw` deflated by zlib at its best compression.
+Bytes deflated(const Bytes& raw) {
+    uLongf size = compressBound(uLong(raw.size()));
+    Bytes out(size);
+    REQUIRE(compress2(out.data(), &size, raw.data(), uLong(raw.size()), 9) == Z_OK);
+    out.resize(size);
+    return out;
+}
+
+// The JPEG `jpeg` with its frame header (the first SOF0) edited: marker, precision, size.
+Bytes with_frame(Bytes jpeg, unsigned marker, unsigned precision, unsigned width, unsigned height) {
+    for (size_t at = 2; at + 9 < jpeg.size(); ++at) {
+        if (jpeg[at] != 0xFF || jpeg[at + 1] != 0xC0) continue;
+        jpeg[at + 1] = (unsigned char)marker;
+        jpeg[at + 4] = (unsigned char)precision;
+        jpeg[at + 5] = (unsigned char)(height >> 8);
+        jpeg[at + 6] = (unsigned char)height;
+        jpeg[at + 7] = (unsigned char)(width >> 8);
+        jpeg[at + 8] = (unsigned char)width;
+        return jpeg;
+    }
+    FAIL("no SOF0 in the JPEG");
+    return jpeg;
 }
 
 Bytes read_file(const std::string& path) {
@@ -685,10 +732,111 @@ TEST_CASE("damaged or oversized images are refused with one line naming them",
                    contains(error, "does not start with a whole IHDR chunk")));
         }
     }
-    SECTION("a corrupt IDAT") {
-        Bytes broken = good;
-        broken[8 + 25 + 8 + 2] ^= 0xFF;  // the first stored block's header
-        CHECK(contains(decode({broken}).error, "image 0: the PNG cannot be decoded"));
+    SECTION("a damaged chunk: its CRC") {
+        // IDAT starts at byte 33, after the signature (8) and IHDR (25).
+        Bytes flipped = good;
+        flipped[33 + 8 + 2] ^= 0xFF;  // the first stored block's header
+        CHECK(contains(decode({flipped}).error, "image 0: PNG chunk IDAT at byte 33: CRC mismatch"));
+        flipped = good;
+        flipped[flipped.size() - 20] ^= 0x01;  // a texel's byte in the stored block
+        CHECK(contains(decode({flipped}).error, "PNG chunk IDAT at byte 33: CRC mismatch"));
+        // An ancillary chunk too: its bytes are as damaged as the others.
+        Bytes tagged = png_file(2, 8, 6, {{255, 0, 0, 255, 0, 0, 255, 128}},
+                                {png_chunk("gAMA", {0, 0, 0xB1, 0x8F})});
+        tagged[33 + 8] ^= 0x01;
+        CHECK(contains(decode({tagged}).error, "PNG chunk gAMA at byte 33: CRC mismatch"));
+        tagged[33 + 8] ^= 0x01;
+        CHECK(decode({tagged}).error.empty());
+    }
+    SECTION("damaged image data behind a right CRC: Adler-32, zlib, filter types") {
+        const Bytes raw = {0, 255, 0, 0, 255, 0, 0, 255, 128};  // one row, filter 0
+        Bytes stream = zlib_stored(raw);
+        CHECK(decode({png_with_stream(2, 1, 8, 6, stream)}).error.empty());
+        stream[7 + 3] ^= 0x10;  // a texel's byte in the stored block: only Adler-32 sees it
+        CHECK(contains(decode({png_with_stream(2, 1, 8, 6, stream)}).error,
+                       "image 0: the PNG's image data fails its Adler-32 check"));
+        stream = zlib_stored(raw);
+        stream[2 + 3] ^= 0xFF;  // the stored block's length check (NLEN)
+        CHECK(contains(decode({png_with_stream(2, 1, 8, 6, stream)}).error,
+                       "image 0: the PNG's IDAT data is not a valid zlib stream: invalid stored "
+                       "block lengths"));
+        stream = zlib_stored(raw);
+        stream.resize(stream.size() - 6);  // cut inside the stream
+        CHECK(contains(decode({png_with_stream(2, 1, 8, 6, stream)}).error,
+                       "the PNG's IDAT data ends inside its zlib stream"));
+        Bytes filter = raw;
+        filter[0] = 5;
+        CHECK(contains(decode({png_with_stream(2, 1, 8, 6, zlib_stored(filter))}).error,
+                       "image 0: the PNG's row 0 has filter type 5 (PNG defines 0 to 4)"));
+    }
+    SECTION("image data that inflates to more or less than the declared size needs") {
+        // 16 × 16 RGBA needs 16 × (1 + 64) = 1040 bytes. Followed by 8 MiB of zeros, which
+        // deflate to about 8 KiB, it would cost stb_image 8 MiB (1 GiB from 1 MB of IDAT); it is
+        // refused at the first 64 KiB past the size.
+        Bytes raw(16 * 65, 0);
+        Bytes more = raw;
+        more.resize(more.size() + (size_t(8) << 20), 0);
+        const Bytes bomb = png_with_stream(16, 16, 8, 6, deflated(more));
+        CHECK(bomb.size() < 20000);
+        CHECK(contains(decode({bomb}).error,
+                       "image 0: the PNG's IDAT data inflates beyond the 1040 bytes its 16 × 16 "
+                       "texels need"));
+        raw.resize(raw.size() - 65);
+        CHECK(contains(decode({png_with_stream(16, 16, 8, 6, deflated(raw))}).error,
+                       "image 0: the PNG's IDAT data inflates to 975 bytes; its 16 × 16 texels "
+                       "need 1040"));
+        raw.resize(raw.size() + 65);
+        CHECK(decode({png_with_stream(16, 16, 8, 6, deflated(raw))}).error.empty());
+    }
+    SECTION("palette indices beyond the palette, through every filter and interlaced") {
+        const Bytes palette = png_chunk("PLTE", {10, 20, 30, 40, 50, 60});  // 2 colours
+        // 8-bit indices 0 1 1 0, then 1 1 1 1 stored with the Sub filter (deltas 1 0 0 0).
+        const Bytes ok = {0, 0, 1, 1, 0, 1, 1, 0, 0, 0};
+        const Decoded d = decode({png_with_stream(4, 2, 8, 3, zlib_stored(ok), {palette})});
+        INFO(d.error);
+        REQUIRE(d.error.empty());
+        CHECK(d.images[0].rgba[4 * 5] == 40);
+        for (unsigned filter = 0; filter <= 4; ++filter) {
+            INFO("filter " << filter);
+            // Row 0 indices 0 1 1 0; row 1 indices 1 1 2 1 written with `filter`.
+            const Bytes row0 = {0, 1, 1, 0}, target = {1, 1, 2, 1};
+            Bytes stored = {0, 0, 1, 1, 0, (unsigned char)filter};
+            for (size_t i = 0; i < 4; ++i) {
+                const int a = i ? target[i - 1] : 0, b = row0[i], c = i ? row0[i - 1] : 0;
+                const int p = a + b - c, pa = std::abs(p - a), pb = std::abs(p - b),
+                          pc = std::abs(p - c);
+                const int predictor[5] = {0, a, b, (a + b) / 2,
+                                          pa <= pb && pa <= pc ? a : pb <= pc ? b : c};
+                stored.push_back((unsigned char)(target[i] - predictor[filter]));
+            }
+            CHECK(contains(decode({png_with_stream(4, 2, 8, 3, zlib_stored(stored), {palette})}).error,
+                           "image 0: the PNG's texel (2, 1) has palette index 2, beyond its "
+                           "2-colour palette"));
+        }
+        // 2-bit indices, packed: 0 1 3 0 in one byte (0b00011100).
+        CHECK(contains(decode({png_with_stream(4, 1, 2, 3, zlib_stored({0, 0x1C}), {palette})}).error,
+                       "texel (2, 0) has palette index 3"));
+        // The padding bits of a row's last byte are not texels: 0 1 in the top 4 bits, 3 3 after.
+        CHECK(decode({png_with_stream(2, 1, 2, 3, zlib_stored({0, 0x1F}), {palette})}).error.empty());
+        // Adam7: 3 × 3 texels in passes 1 (0, 0), 2 none, 3 none, 4 (2, 0), 5 none... per PNG
+        // 8.2: pass 1 texel (0,0); pass 4 (2,0); pass 5 (0,2),(2,2); pass 6 (1,0),(1,2); pass 7
+        // row 1: (0,1),(1,1),(2,1). Index 2 at (1, 1), in pass 7.
+        const Bytes interlaced = {0, 0,  0, 0,  0, 0, 0,  0, 0,  0, 0,  0, 1, 2, 1};
+        CHECK(contains(decode({png_with_stream(3, 3, 8, 3, zlib_stored(interlaced), {palette}, true)}).error,
+                       "the PNG's texel (1, 1) has palette index 2"));
+        Bytes fine = interlaced;
+        fine[13] = 1;
+        const Decoded adam7 = decode({png_with_stream(3, 3, 8, 3, zlib_stored(fine), {palette}, true)});
+        REQUIRE(adam7.error.empty());
+        CHECK(adam7.images[0].rgba[4 * 4] == 40);  // texel (1, 1): colour 1
+        CHECK(adam7.images[0].rgba[4 * 3] == 40);  // texel (0, 1)
+        CHECK(adam7.images[0].rgba[0] == 10);      // texel (0, 0): colour 0
+    }
+    SECTION("IHDR fields PNG does not define, a palette image without PLTE") {
+        CHECK(contains(decode({png_with_stream(1, 1, 3, 2, zlib_stored({0, 0}))}).error,
+                       "the PNG's IHDR declares colour type 2 with bit depth 3"));
+        CHECK(contains(decode({png_with_stream(1, 1, 8, 3, zlib_stored({0, 0}))}).error,
+                       "the PNG is a palette image without a PLTE chunk"));
     }
     SECTION("an unknown critical chunk, or none of IHDR first") {
         Bytes odd = png_signature();
@@ -728,6 +876,57 @@ TEST_CASE("damaged or oversized images are refused with one line naming them",
         jpeg.resize(jpeg.size() / 2);
         CHECK(contains(decode({jpeg}).error, "image 0: the JPEG cannot be decoded"));
     }
+    SECTION("a JPEG whose frame declares more texels than its bytes can hold") {
+        const Bytes small = baseline_jpeg(8, 8, Bytes(3 * 64, 90));
+        const Bytes lying = with_frame(small, 0xC0, 8, 8192, 8192);
+        CHECK(contains(decode({lying}).error,
+                       "image 0: the JPEG's " + std::to_string(lying.size()) +
+                           " bytes cannot hold the 8192 × 8192 texels it declares: its 3145728 "
+                           "blocks of 8 × 8 need at least 393216 (a bit each)"));
+        CHECK(contains(decode({with_frame(small, 0xC0, 8, 16384, 16384)}).error,
+                       "cannot hold the 16384 × 16384 texels"));
+        CHECK(contains(decode({with_frame(small, 0xC0, 8, 20000, 8)}).error,
+                       "20000 × 8 texels: more than the 16384 per side"));
+        // A real 1024 × 1024 JPEG of one colour is about 100 KiB against 49152 bytes at least.
+        const Bytes flat = baseline_jpeg(1024, 1024, Bytes(3 * 1024 * 1024, 90));
+        INFO("flat JPEG of " << flat.size() << " bytes");
+        const Decoded d = decode({flat});
+        CHECK(d.error.empty());
+    }
+    SECTION("JPEG codings stb_image lacks are named, not called corrupt") {
+        const Bytes small = baseline_jpeg(8, 8, Bytes(3 * 64, 90));
+        const struct {
+            unsigned marker, precision;
+            const char* why;
+        } codings[] = {
+            {0xC1, 12, "the JPEG has 12-bit samples (SOF1), which the decoder mcrt uses (stb_image) "
+                       "reads baseline and progressive Huffman JPEG of 8-bit samples only"},
+            {0xC2, 12, "12-bit samples (SOF2)"},
+            {0xC3, 8, "the JPEG is lossless (SOF3), a coding that the decoder mcrt uses (stb_image) "
+                      "reads baseline and progressive Huffman JPEG of 8-bit samples"},
+            {0xC5, 8, "hierarchical (differential sequential) (SOF5)"},
+            {0xC7, 16, "hierarchical lossless (SOF7)"},
+            {0xC9, 8, "arithmetic-coded (extended sequential) (SOF9)"},
+            {0xCA, 8, "arithmetic-coded progressive (SOF10)"},
+            {0xCB, 8, "arithmetic-coded lossless (SOF11)"},
+        };
+        for (const auto& c : codings) {
+            INFO(c.why);
+            const std::string error = decode({with_frame(small, c.marker, c.precision, 8, 8)}).error;
+            CHECK(contains(error, "image 0: the JPEG "));
+            CHECK(contains(error, c.why));
+            CHECK_FALSE(contains(error, "corrupt"));
+        }
+        // A DAC segment (arithmetic conditioning) before the frame.
+        Bytes dac = {0xFF, 0xD8, 0xFF, 0xCC, 0x00, 0x04, 0x00, 0x10};
+        dac.insert(dac.end(), small.begin() + 2, small.end());
+        CHECK(contains(decode({dac}).error, "the JPEG is arithmetic-coded (a DAC marker)"));
+        // The height in a DNL marker after the first scan: named too.
+        CHECK(contains(decode({with_frame(small, 0xC0, 8, 8, 0)}).error,
+                       "the JPEG's height comes after its first scan (a DNL marker)"));
+        // Extended sequential Huffman of 8-bit samples is read (stb_image decodes SOF1 as SOF0).
+        CHECK(decode({with_frame(small, 0xC1, 8, 8, 8)}).error.empty());
+    }
     SECTION("of several bad images the first in slot order is reported, whatever the threads") {
         Bytes cut = good;
         cut.resize(30);
@@ -736,9 +935,11 @@ TEST_CASE("damaged or oversized images are refused with one line naming them",
             CHECK(contains(decode(files, {2, 1, 0}, threads).error, "image 2:"));
             CHECK(contains(decode(files, {1, 0, 2}, threads).error, "image 0:"));
         }
-        // Decoding failures too (both pass the header checks).
-        Bytes broken = good;
-        broken[8 + 25 + 8 + 2] ^= 0xFF;
+        // Decoding failures too (both pass the header checks): image data behind a right CRC
+        // that fails its Adler-32.
+        Bytes stream = zlib_stored({0, 255, 0, 0, 255, 0, 0, 255, 128});
+        stream[7 + 3] ^= 0x10;
+        const Bytes broken = png_with_stream(2, 1, 8, 6, stream);
         for (unsigned threads : {1u, 3u}) {
             CHECK(contains(decode({good, broken, broken}, {0, 2, 1}, threads).error, "image 2:"));
         }
