@@ -15,6 +15,8 @@
 #include <zlib.h>
 
 #include "common/error.h"
+#include "image/jpeg_structure.h"
+#include "image/png_structure.h"
 #include "image_bytes.h"
 #include "scene/gltf_images.h"
 #include "scene/gltf_import.h"
@@ -859,6 +861,12 @@ TEST_CASE("damaged or oversized images are refused with one line naming them",
         CHECK(contains(decode({png_header_only(4096, 4096, 100)}).error,
                        "image 0: the PNG's 100 bytes of IDAT data cannot hold the 4096 × 4096 "
                        "texels it declares"));
+        // 16-bit RGBA at 16384²: stb_image's image buffer would pass 2 GiB, which it refuses
+        // only after inflating (and under another decoder's error).
+        CHECK(contains(decode({png_with_stream(16384, 16384, 16, 6, Bytes(2100000, 0))}).error,
+                       "image 0: 16384 × 16384 texels of 16-bit samples need a buffer of "
+                       "2147500032 bytes, more than the 2 GiB stb_image (mcrt's decoder) "
+                       "allocates at once"));
         // Four 16384² images are 2^30 texels, the budget; a fifth, even 1×1, is over it. (Each
         // IDAT is just long enough to pass for 1 GiB of deflated samples: never decoded.)
         std::vector<Bytes> five(4, png_header_only(16384, 16384, 1100000));
@@ -944,6 +952,56 @@ TEST_CASE("damaged or oversized images are refused with one line naming them",
             CHECK(contains(decode({good, broken, broken}, {0, 2, 1}, threads).error, "image 2:"));
         }
     }
+}
+
+TEST_CASE("PNG scanline bytes: Adam7 passes counted texel by texel; JPEG blocks by sampling",
+          "[textures][png][jpeg]") {
+    // Adam7 (PNG 8.2): the pass of texel (x, y), from the 8 × 8 pattern.
+    const int pattern[8][8] = {{1, 6, 4, 6, 2, 6, 4, 6}, {7, 7, 7, 7, 7, 7, 7, 7},
+                               {5, 6, 5, 6, 5, 6, 5, 6}, {7, 7, 7, 7, 7, 7, 7, 7},
+                               {3, 6, 4, 6, 3, 6, 4, 6}, {7, 7, 7, 7, 7, 7, 7, 7},
+                               {5, 6, 5, 6, 5, 6, 5, 6}, {7, 7, 7, 7, 7, 7, 7, 7}};
+    for (uint32_t w : {1u, 2u, 3u, 5u, 8u, 13u}) {
+        for (uint32_t h : {1u, 2u, 4u, 7u, 9u}) {
+            for (unsigned depth : {1u, 2u, 8u, 16u}) {
+                PngLayout layout;
+                layout.width = w;
+                layout.height = h;
+                layout.depth = uint8_t(depth);
+                layout.colour_type = depth == 16 ? 6 : 0;
+                const uint64_t bits = png_bits_per_texel(layout);
+                CHECK(png_filtered_bytes(layout) == h * (1 + (w * bits + 7) / 8));
+                // Each pass: its rows (those holding any of its texels), each of its texels.
+                uint64_t expected = 0;
+                for (int pass = 1; pass <= 7; ++pass) {
+                    uint64_t columns = 0, rows = 0;
+                    std::vector<uint64_t> per_row(h, 0);
+                    for (uint32_t y = 0; y < h; ++y)
+                        for (uint32_t x = 0; x < w; ++x) per_row[y] += pattern[y % 8][x % 8] == pass;
+                    for (uint32_t y = 0; y < h; ++y) {
+                        if (per_row[y] == 0) continue;
+                        ++rows;
+                        columns = per_row[y];  // the same in every row of a pass
+                    }
+                    if (rows > 0) expected += rows * (1 + (columns * bits + 7) / 8);
+                }
+                layout.interlaced = true;
+                INFO(w << " × " << h << " at " << depth << " bits");
+                CHECK(png_filtered_bytes(layout) == expected);
+            }
+        }
+    }
+    // JPEG 4:2:0 (Y sampled 2 × 2): a 17 × 9 image is 3 × 2 blocks of Y (its texels) and 2 × 1 of
+    // each chroma; padded to whole 16 × 16 MCUs, 32 × 16 samples of Y and 16 × 8 of each chroma.
+    Bytes frame = {0xFF, 0xD8, 0xFF, 0xC0, 0, 17, 8, 0, 9, 0, 17, 3,
+                   1, 0x22, 0, 2, 0x11, 1, 3, 0x11, 1};
+    JpegFrame parsed;
+    REQUIRE(read_jpeg_frame(frame.data(), frame.size(), parsed).empty());
+    CHECK(parsed.width == 17);
+    CHECK(parsed.height == 9);
+    CHECK(parsed.blocks == 3 * 2 + 2 * (2 * 1));
+    CHECK(jpeg_min_bytes(parsed) == 2);
+    CHECK(parsed.padded_samples == 32 * 16 + 2 * (16 * 8));
 }
 
 TEST_CASE("the textured sample scenes load with every used image decoded",

@@ -2,8 +2,10 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdlib>
+#include <cstring>
 #include <new>
 
 namespace mcrt {
@@ -83,21 +85,26 @@ class RowWalker {
         start_pass(0);
     }
 
-    // `size` more bytes; "" or why they are not image data of the declared size.
+    // `size` more bytes; "" or why they are not image data of the declared size. A row's
+    // samples are passed over whole (copied for a palette image): only filter bytes are read.
     std::string feed(const unsigned char* data, size_t size) {
-        for (size_t i = 0; i < size; ++i) {
+        for (size_t i = 0; i < size;) {
             if (pass_ == passes_.size()) return "the PNG's IDAT data inflates beyond its rows";
-            const unsigned char byte = data[i];
             if (column_ == 0) {
-                if (byte > 4) {
+                if (data[i] > 4) {
                     return "the PNG's row " + std::to_string(image_row()) + pass_name() +
-                           " has filter type " + std::to_string(byte) + " (PNG defines 0 to 4)";
+                           " has filter type " + std::to_string(data[i]) +
+                           " (PNG defines 0 to 4)";
                 }
-                filter_ = byte;
-            } else if (palette()) {
-                row_[column_ - 1] = byte;
+                filter_ = data[i++];
+                column_ = 1;
+            } else {
+                const size_t n = size_t(std::min<uint64_t>(size - i, row_bytes_ + 1 - column_));
+                if (palette()) std::memcpy(row_.data() + (column_ - 1), data + i, n);
+                i += n;
+                column_ += n;
             }
-            if (++column_ == row_bytes_ + 1) {
+            if (column_ == row_bytes_ + 1) {
                 if (palette()) {
                     const std::string why = finish_palette_row();
                     if (!why.empty()) return why;

@@ -142,6 +142,22 @@ void read_png_header(Encoded& encoded, const Diagnostics& diag) {
                                        std::to_string(encoded.width) + " × " +
                                        std::to_string(encoded.height) + " texels it declares");
     }
+    // stb_image allocates each of its buffers only up to INT_MAX bytes (stbi__mad3sizes_valid),
+    // the inflated scanlines' size in an int: 16-bit RGB(A) at 16384² fails it, after a full
+    // inflate, under another decoder's error ("no SOI"). Its image has 4 channels for colour and
+    // palette, up to 2 for grey.
+    const uint64_t image_bytes = uint64_t(encoded.width) * encoded.height *
+                                 (encoded.png.colour_type == 0 || encoded.png.colour_type == 4 ? 2 : 4) *
+                                 (encoded.png.depth == 16 ? 2 : 1);
+    const uint64_t largest = std::max(image_bytes, png_filtered_bytes(encoded.png));
+    if (largest > uint64_t(INT_MAX)) {
+        diag.fail(encoded.element, std::to_string(encoded.width) + " × " +
+                                       std::to_string(encoded.height) + " texels of " +
+                                       std::to_string(encoded.png.depth) +
+                                       "-bit samples need a buffer of " + std::to_string(largest) +
+                                       " bytes, more than the 2 GiB stb_image (mcrt's decoder) "
+                                       "allocates at once");
+    }
 }
 
 // The JPEG's frame header (jpeg_structure.h): a coding stb_image reads, a size within the limits
