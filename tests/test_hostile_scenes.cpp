@@ -3,6 +3,7 @@
 // render) naming the cause; what is accepted with a warning warns once. Cases that hung or crashed the old loader
 // run through the mcrt executable, so that a regression fails the test instead of hanging it.
 #include <sys/stat.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -232,6 +233,26 @@ TEST_CASE("textured scenes with damaged images or references are refused in one 
     require_render_refused(
         scene_with("image_range.gltf", R"([{"uri": "good.png"}])", R"([{"source": 1}])"),
         "texture 0: source image 1 out of range");
+    // A damaged byte (the texel of a stored block): named by its chunk's CRC.
+    std::vector<unsigned char> damaged = png;
+    damaged[33 + 8 + 7 + 1] ^= 0x01;
+    write_text(dir / "damaged.png", std::string(damaged.begin(), damaged.end()));
+    require_render_refused(scene_with("damaged.gltf", R"([{"uri": "damaged.png"}])"),
+                           "image 0 (damaged.png): PNG chunk IDAT at byte 33: CRC mismatch");
+    // 1 × 1 declared, 64 MiB of zeros deflated to 64 KiB: refused before stb_image inflates it.
+    std::vector<unsigned char> zeros(size_t(64) << 20, 0);
+    uLongf deflated_size = compressBound(uLong(zeros.size()));
+    std::vector<unsigned char> deflated(deflated_size);
+    REQUIRE(compress2(deflated.data(), &deflated_size, zeros.data(), uLong(zeros.size()), 9) == Z_OK);
+    deflated.resize(deflated_size);
+    std::vector<unsigned char> bomb = png_signature();
+    for (const std::vector<unsigned char>& chunk :
+         {png_ihdr(1, 1, 8, 0), png_chunk("IDAT", deflated), png_chunk("IEND", {})})
+        bomb.insert(bomb.end(), chunk.begin(), chunk.end());
+    write_text(dir / "bomb.png", std::string(bomb.begin(), bomb.end()));
+    require_render_refused(scene_with("bomb.gltf", R"([{"uri": "bomb.png"}])"),
+                           "image 0 (bomb.png): the PNG's IDAT data inflates beyond the 2 bytes "
+                           "its 1 × 1 texels need");
     // A KTX2 image (KHR_texture_basisu's): named by its extension.
     const std::string ktx2 = "\xABKTX 20\xBB\r\n\x1A\n" + std::string(52, '\0');
     write_text(dir / "image.ktx2", ktx2);
