@@ -17,16 +17,26 @@ bool is_frame_marker(unsigned m) {
 // ones it does (SOF0 baseline, SOF1 extended sequential, SOF2 progressive, all Huffman).
 const char* unsupported_coding(unsigned m) {
     switch (m) {
-        case 0xC3: return "lossless";
-        case 0xC5: return "hierarchical (differential sequential)";
-        case 0xC6: return "hierarchical (differential progressive)";
-        case 0xC7: return "hierarchical lossless";
-        case 0xC9: return "arithmetic-coded (extended sequential)";
-        case 0xCA: return "arithmetic-coded progressive";
-        case 0xCB: return "arithmetic-coded lossless";
-        case 0xCD: return "arithmetic-coded hierarchical (differential sequential)";
-        case 0xCE: return "arithmetic-coded hierarchical (differential progressive)";
-        case 0xCF: return "arithmetic-coded hierarchical lossless";
+        case 0xC3:
+            return "lossless";
+        case 0xC5:
+            return "hierarchical (differential sequential)";
+        case 0xC6:
+            return "hierarchical (differential progressive)";
+        case 0xC7:
+            return "hierarchical lossless";
+        case 0xC9:
+            return "arithmetic-coded (extended sequential)";
+        case 0xCA:
+            return "arithmetic-coded progressive";
+        case 0xCB:
+            return "arithmetic-coded lossless";
+        case 0xCD:
+            return "arithmetic-coded hierarchical (differential sequential)";
+        case 0xCE:
+            return "arithmetic-coded hierarchical (differential progressive)";
+        case 0xCF:
+            return "arithmetic-coded hierarchical lossless";
     }
     return nullptr;
 }

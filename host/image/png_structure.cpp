@@ -25,11 +25,14 @@ unsigned samples_of(unsigned colour_type) {
 // PNG 11.2.2, Table 11.1: the bit depths each colour type allows.
 bool depth_allowed(unsigned colour_type, unsigned depth) {
     switch (colour_type) {
-        case 0: return depth == 1 || depth == 2 || depth == 4 || depth == 8 || depth == 16;
-        case 3: return depth == 1 || depth == 2 || depth == 4 || depth == 8;
+        case 0:
+            return depth == 1 || depth == 2 || depth == 4 || depth == 8 || depth == 16;
+        case 3:
+            return depth == 1 || depth == 2 || depth == 4 || depth == 8;
         case 2:
         case 4:
-        case 6: return depth == 8 || depth == 16;
+        case 6:
+            return depth == 8 || depth == 16;
     }
     return false;
 }
@@ -93,8 +96,7 @@ class RowWalker {
             if (column_ == 0) {
                 if (data[i] > 4) {
                     return "the PNG's row " + std::to_string(image_row()) + pass_name() +
-                           " has filter type " + std::to_string(data[i]) +
-                           " (PNG defines 0 to 4)";
+                           " has filter type " + std::to_string(data[i]) + " (PNG defines 0 to 4)";
                 }
                 filter_ = data[i++];
                 column_ = 1;
@@ -119,7 +121,9 @@ class RowWalker {
   private:
     bool palette() const { return layout_.colour_type == 3; }
 
-    uint64_t image_row() const { return passes_[pass_].y0 + uint64_t(row_index_) * passes_[pass_].dy; }
+    uint64_t image_row() const {
+        return passes_[pass_].y0 + uint64_t(row_index_) * passes_[pass_].dy;
+    }
     std::string pass_name() const {
         return layout_.interlaced ? " (Adam7 pass " + std::to_string(pass_ + 1) + ")" : "";
     }
@@ -149,9 +153,15 @@ class RowWalker {
                       c = i > 0 ? previous_[i - 1] : 0;
             int predictor = 0;
             switch (filter_) {
-                case 1: predictor = a; break;
-                case 2: predictor = b; break;
-                case 3: predictor = (a + b) / 2; break;
+                case 1:
+                    predictor = a;
+                    break;
+                case 2:
+                    predictor = b;
+                    break;
+                case 3:
+                    predictor = (a + b) / 2;
+                    break;
                 case 4: {
                     const int p = a + b - c, pa = std::abs(p - a), pb = std::abs(p - b),
                               pc = std::abs(p - c);
@@ -216,8 +226,7 @@ std::string read_png_layout(const unsigned char* data, size_t size, PngLayout& l
         }
         if (length > size - at - 12) {
             return "the PNG is truncated: its chunk at byte " + std::to_string(at) + " holds " +
-                   std::to_string(length) + " bytes, " + std::to_string(size - at - 12) +
-                   " remain";
+                   std::to_string(length) + " bytes, " + std::to_string(size - at - 12) + " remain";
         }
         const unsigned char* field = data + at + 8;
         if (big_endian_32(field + length) != crc32(0, data + at + 4, uInt(4 + length))) {

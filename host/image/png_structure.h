@@ -17,9 +17,9 @@ namespace mcrt {
 struct PngLayout {
     uint32_t width = 0, height = 0;
     uint8_t depth = 0, colour_type = 0;
-    bool interlaced = false;      // Adam7
-    uint32_t palette_entries = 0; // PLTE's, for colour type 3
-    uint64_t idat_bytes = 0;      // over all IDAT chunks
+    bool interlaced = false;                      // Adam7
+    uint32_t palette_entries = 0;                 // PLTE's, for colour type 3
+    uint64_t idat_bytes = 0;                      // over all IDAT chunks
     std::vector<std::pair<size_t, size_t>> idat;  // each IDAT's data: offset, length
 };
 

@@ -258,8 +258,8 @@ void GeometryImporter::note_left_out_textures(int material_index, const std::str
     std::string material = element_name("material", size_t(material_index));
     const std::string& name = model_.materials[size_t(material_index)].name;
     if (!name.empty()) material += " (\"" + name + "\")";
-    left_out_first_ = element + ": lacks the texture coordinates that " + material +
-                      " reads for " + left_out +
+    left_out_first_ = element + ": lacks the texture coordinates that " + material + " reads for " +
+                      left_out +
                       "; ignored there, the factors alone apply (glTF 2.0 \"Texture Data\": a "
                       "primitive MUST have them)";
 }
@@ -267,10 +267,10 @@ void GeometryImporter::note_left_out_textures(int material_index, const std::str
 void GeometryImporter::finish() {
     if (!left_out_primitives_.empty()) {
         const size_t others = left_out_primitives_.size() - 1;
-        diag_.warn_once("texcoord-missing",
-                        left_out_first_ + (others ? "; the same on " + std::to_string(others) +
-                                                        " more primitive(s)"
-                                                  : ""));
+        diag_.warn_once(
+            "texcoord-missing",
+            left_out_first_ +
+                (others ? "; the same on " + std::to_string(others) + " more primitive(s)" : ""));
     }
     // Light selection divides by shares of the total: it must be a float too.
     if (!(total_power_ <= 0.5 * std::numeric_limits<float>::max())) {

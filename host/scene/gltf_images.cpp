@@ -33,8 +33,8 @@ struct Encoded {
     size_t size = 0;
     Format format = Format::Png;
     unsigned width = 0, height = 0;
-    PngLayout png;    // a PNG's chunks
-    JpegFrame jpeg;   // a JPEG's frame header
+    PngLayout png;              // a PNG's chunks
+    JpegFrame jpeg;             // a JPEG's frame header
     uint64_t decode_bytes = 0;  // what decoding it holds at most (decode_bytes())
 };
 
@@ -146,9 +146,10 @@ void read_png_header(Encoded& encoded, const Diagnostics& diag) {
     // the inflated scanlines' size in an int: 16-bit RGB(A) at 16384² fails it, after a full
     // inflate, under another decoder's error ("no SOI"). Its image has 4 channels for colour and
     // palette, up to 2 for grey.
-    const uint64_t image_bytes = uint64_t(encoded.width) * encoded.height *
-                                 (encoded.png.colour_type == 0 || encoded.png.colour_type == 4 ? 2 : 4) *
-                                 (encoded.png.depth == 16 ? 2 : 1);
+    const uint64_t image_bytes =
+        uint64_t(encoded.width) * encoded.height *
+        (encoded.png.colour_type == 0 || encoded.png.colour_type == 4 ? 2 : 4) *
+        (encoded.png.depth == 16 ? 2 : 1);
     const uint64_t largest = std::max(image_bytes, png_filtered_bytes(encoded.png));
     if (largest > uint64_t(INT_MAX)) {
         diag.fail(encoded.element, std::to_string(encoded.width) + " × " +
@@ -172,13 +173,11 @@ void read_jpeg_header(Encoded& encoded, const Diagnostics& diag) {
     check_size(encoded, diag);
     const uint64_t least = jpeg_min_bytes(frame);
     if (encoded.size < least) {
-        diag.fail(encoded.element, "the JPEG's " + std::to_string(encoded.size) +
-                                       " bytes cannot hold the " + std::to_string(frame.width) +
-                                       " × " + std::to_string(frame.height) +
-                                       " texels it declares: its " +
-                                       std::to_string(frame.blocks) +
-                                       " blocks of 8 × 8 need at least " + std::to_string(least) +
-                                       " (a bit each)");
+        diag.fail(encoded.element,
+                  "the JPEG's " + std::to_string(encoded.size) + " bytes cannot hold the " +
+                      std::to_string(frame.width) + " × " + std::to_string(frame.height) +
+                      " texels it declares: its " + std::to_string(frame.blocks) +
+                      " blocks of 8 × 8 need at least " + std::to_string(least) + " (a bit each)");
     }
 }
 
@@ -296,7 +295,8 @@ std::vector<TextureImage> decode_images(const tinygltf::Model& model,
             if (next == sources.size()) return;
             const size_t k = next++;
             const uint64_t need = encoded[k].decode_bytes;
-            room.wait(lock, [&] { return in_flight == 0 || in_flight + need <= kMaxDecodingBytes; });
+            room.wait(lock,
+                      [&] { return in_flight == 0 || in_flight + need <= kMaxDecodingBytes; });
             in_flight += need;
             lock.unlock();
             try {

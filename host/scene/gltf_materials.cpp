@@ -184,7 +184,7 @@ uint32_t MaterialTable::slot(int material_index, const std::string& referrer) {
 }
 
 uint32_t MaterialTable::slot_for_texcoords(uint32_t slot, uint32_t texcoord_sets,
-                                          std::string& left_out) {
+                                           std::string& left_out) {
     left_out.clear();
     uint32_t missing = 0;
     const Material& material = materials_[slot];
