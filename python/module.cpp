@@ -426,7 +426,7 @@ PYBIND11_MODULE(_mcrt, m) {
                              state->warnings.push_back(w);
                          };
                          state->session =
-                             std::make_unique<RenderSession>(select_devices(devices, warn));
+                             std::make_unique<RenderSession>(select_devices(devices, warn), warn);
                          return 0;
                      },
                      InputKind::Setting);

@@ -298,7 +298,7 @@ int render_here(const RenderOptions& o, RenderJob* job) {
         files.clear();
     }
 
-    RenderSession session(select_devices(o.devices, print_warning));
+    RenderSession session(select_devices(o.devices, print_warning), print_warning);
 
     RenderControl control;
     control.time_limit = o.time_limit;

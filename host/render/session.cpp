@@ -81,10 +81,17 @@ std::shared_ptr<DeviceContext> process_device_context(const DeviceInfo& device) 
     return context;
 }
 
-RenderSession::RenderSession(const std::vector<DeviceInfo>& devices) {
+RenderSession::RenderSession(const std::vector<DeviceInfo>& devices, const WarningSink& warn) {
     for (const DeviceInfo& d : devices) {
-        contexts_.push_back(process_device_context(d));
-        device_list_.push_back(contexts_.back().get());
+        try {
+            contexts_.push_back(process_device_context(d));
+            device_list_.push_back(contexts_.back().get());
+        } catch (const RuntimeError& e) {
+            if (devices.size() == 1 || (contexts_.empty() && &d == &devices.back())) throw;
+            if (warn)
+                warn("skipping device " + std::to_string(d.index) + " ('" + d.name + "'): " +
+                     e.what());
+        }
     }
 }
 

@@ -59,8 +59,10 @@ std::shared_ptr<DeviceContext> process_device_context(const DeviceInfo& device);
 class RenderSession {
   public:
     // Renders on the devices, in the order given, through the process's context and queue of
-    // each (process_device_context).
-    explicit RenderSession(const std::vector<DeviceInfo>& devices);
+    // each (process_device_context). With more than one device, one whose context or queue
+    // cannot be made is skipped with a warning through `warn`; the error is thrown when no
+    // device is left (or for the only one).
+    explicit RenderSession(const std::vector<DeviceInfo>& devices, const WarningSink& warn = {});
     RenderSession(const RenderSession&) = delete;
     RenderSession& operator=(const RenderSession&) = delete;
 
