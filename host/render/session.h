@@ -1,9 +1,9 @@
 // A render session: the devices, and what every render of a loaded scene shares, kept from one
 // render to the next. A scene is read, its BVH built and laid out for the devices once
 // (load_session_scene); a render of it plans its request (plan_session_render: the settings
-// checked, the camera chosen, the light selection's data built once per selection) and runs on
-// the session's devices, where the scene's buffers are uploaded at its first render and each
-// light selection's at the first render that uses it. Compiled programs are kept per process
+// checked, the camera chosen) and runs on the session's devices, where the scene's buffers are
+// uploaded at its first render and each light selection's data built and uploaded at the first
+// render that uses it. Compiled programs are kept per process
 // (cl/program.h, cached_program). The command line renders through a session of one request;
 // the Python module (python/) keeps one per mcrt.Context.
 #pragma once
@@ -27,11 +27,11 @@ struct SessionScene {
     std::string path;
     std::string materials;  // a row of kMaterialVariants
     // The camera is the scene's default (choose_camera) until a plan chooses one; the device
-    // layout holds the data of the light selection last planned.
+    // layout holds the data of the light selection last uploaded.
     PreparedScene prepared;
     uint64_t id = 0;  // unique in the process: what a session's uploads are kept under
     // Held by a caller that plans and renders the scene from several threads (the Python
-    // module): a plan changes the light selection's data and the camera.
+    // module): a plan changes the camera, a render the light selection's data.
     std::mutex use;
 };
 
@@ -45,9 +45,9 @@ std::shared_ptr<SessionScene> load_session_scene(const std::string& path,
                                                  const WarningSink& warn);
 
 // The plan of `request` for the loaded scene, as plan_render makes it: the settings checked
-// (SettingError), the camera chosen (SettingError) into scene.prepared.camera, the light
-// selection's data built on the host, the warnings of plan_render (no triangles, no lights for
-// an estimator that needs them). The request's materials must be the scene's.
+// (SettingError), the camera chosen (SettingError) into scene.prepared.camera, the warnings of
+// plan_render (no triangles, no lights for an estimator that needs them). The request's
+// materials must be the scene's.
 RenderPlan plan_session_render(SessionScene& scene, const RenderRequest& request,
                                const WarningSink& warn);
 
