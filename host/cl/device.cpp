@@ -1,6 +1,7 @@
 #include "cl/device.h"
 
 #include "cl/cl_error.h"
+#include "common/test_hooks.h"
 
 namespace mcrt {
 
@@ -70,9 +71,26 @@ std::vector<DeviceInfo> enumerate_devices(const std::function<void(const std::st
 DeviceContext::DeviceContext(const DeviceInfo& info_) : info(info_) {
     cl_int status = CL_SUCCESS;
     context = cl::Context(info.device, nullptr, nullptr, nullptr, &status);
+    if (test_context_failure(info.index)) status = CL_DEVICE_NOT_AVAILABLE;
     CL_CHECK_STATUS(status, "clCreateContext");
     queue = cl::CommandQueue(context, info.device, CL_QUEUE_PROFILING_ENABLE, &status);
     CL_CHECK_STATUS(status, "clCreateCommandQueue");
+}
+
+std::vector<std::unique_ptr<DeviceContext>> open_devices(
+    const std::vector<DeviceInfo>& devices, const std::function<void(const std::string&)>& warn) {
+    std::vector<std::unique_ptr<DeviceContext>> contexts;
+    for (const DeviceInfo& d : devices) {
+        try {
+            contexts.push_back(std::make_unique<DeviceContext>(d));
+        } catch (const RuntimeError& e) {
+            if (devices.size() == 1 || (contexts.empty() && &d == &devices.back())) throw;
+            if (warn)
+                warn("skipping device " + std::to_string(d.index) + " ('" + d.name + "'): " +
+                     e.what());
+        }
+    }
+    return contexts;
 }
 
 }  // namespace mcrt

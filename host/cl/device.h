@@ -2,6 +2,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -38,5 +39,12 @@ struct DeviceContext {
     cl::Context context;
     cl::CommandQueue queue;
 };
+
+// A context and queue for each device. With more than one, a device whose context or queue cannot
+// be made (a driver that refuses its own settings: Intel's with CL_CONFIG_CPU_TARGET_ARCH=junk
+// answers CL_DEVICE_NOT_AVAILABLE) is skipped with a warning through `warn`, as a device whose
+// compiler crashes is; the error is thrown when no device is left (or for the only one).
+std::vector<std::unique_ptr<DeviceContext>> open_devices(
+    const std::vector<DeviceInfo>& devices, const std::function<void(const std::string&)>& warn);
 
 }  // namespace mcrt

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <map>
 #include <sstream>
 
@@ -41,8 +42,9 @@ volatile std::sig_atomic_t g_interrupted = 0;
 
 extern "C" void on_interrupt(int) { g_interrupted = 1; }
 
-// While a render runs, SIGINT and SIGTERM ask it to stop and write the samples done so far;
-// a second signal ends the process at once.
+// While a render runs, SIGINT, SIGTERM and SIGHUP (kStopSignals) ask it to stop and write the
+// samples done so far; a second signal ends the process at once. SIGHUP stays ignored where it
+// was (nohup).
 struct InterruptGuard {
     InterruptGuard() {
         g_interrupted = 0;
@@ -51,16 +53,18 @@ struct InterruptGuard {
         action.sa_handler = on_interrupt;
         action.sa_flags = SA_RESETHAND;
         sigemptyset(&action.sa_mask);
-        sigaction(SIGINT, &action, &old_int);
-        sigaction(SIGTERM, &action, &old_term);
+        for (size_t i = 0; i < std::size(kStopSignals); ++i) {
+            sigaction(kStopSignals[i], nullptr, &old[i]);
+            if (kStopSignals[i] == SIGHUP && old[i].sa_handler == SIG_IGN) continue;
+            sigaction(kStopSignals[i], &action, nullptr);
+        }
     }
     ~InterruptGuard() {
         if (outputs_are_complete()) return;  // stop signals stay ignored: nothing left to save
-        sigaction(SIGINT, &old_int, nullptr);
-        sigaction(SIGTERM, &old_term, nullptr);
+        for (size_t i = 0; i < std::size(kStopSignals); ++i)
+            sigaction(kStopSignals[i], &old[i], nullptr);
     }
-    struct sigaction old_int {
-    }, old_term{};
+    struct sigaction old[std::size(kStopSignals)] {};
 };
 
 glm::vec3 parse_sky(const std::string& text) {
@@ -264,20 +268,20 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     }
 
     std::vector<DeviceInfo> devices = select_devices(o.devices, print_warning);
-    std::vector<std::unique_ptr<DeviceContext>> contexts;
+    const std::vector<std::unique_ptr<DeviceContext>> contexts = open_devices(devices, print_warning);
     std::vector<const DeviceContext*> device_list;
-    for (const DeviceInfo& d : devices) {
-        contexts.push_back(std::make_unique<DeviceContext>(d));
-        device_list.push_back(contexts.back().get());
-    }
+    for (const auto& context : contexts) device_list.push_back(context.get());
 
     RenderControl control;
     control.time_limit = o.time_limit;
     control.interrupted = &g_interrupted;
     control.launching = [&] {
-        report_to_supervisor("launch " + std::to_string(o.time_limit) + (o.quiet ? " 0" : " 1"));
+        // Every digit: std::to_string's six decimals would make a limit below 5e-7 s "0", none.
+        char limit[32];
+        std::snprintf(limit, sizeof limit, "%.17g", o.time_limit);
+        report_to_supervisor(std::string("launch ") + limit + (o.quiet ? " 0" : " 1"));
     };
-    InterruptGuard interrupt_guard;  // SIGINT / SIGTERM: stop and write what is done
+    InterruptGuard interrupt_guard;  // SIGINT / SIGTERM / SIGHUP: stop and write what is done
     ProgressBar bar(!o.quiet, uint64_t(o.width) * o.height);
     const double seconds_to_render =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

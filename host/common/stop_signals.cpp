@@ -1,7 +1,5 @@
 #include "common/stop_signals.h"
 
-#include <csignal>
-
 namespace mcrt {
 
 namespace {
@@ -10,8 +8,7 @@ volatile std::sig_atomic_t g_outputs_complete = 0;
 
 void outputs_complete() {
     g_outputs_complete = 1;
-    std::signal(SIGINT, SIG_IGN);
-    std::signal(SIGTERM, SIG_IGN);
+    for (int sig : kStopSignals) std::signal(sig, SIG_IGN);
 }
 
 bool outputs_are_complete() { return g_outputs_complete != 0; }

@@ -1,10 +1,17 @@
-// After every output is complete a stop signal has nothing left to save: SIGINT and SIGTERM are
-// ignored from then on, so the process still exits 0 (ROBUSTNESS.md "Signals and pipes").
+// The signals that ask a render to stop, and what becomes of them once its outputs are complete
+// (ROBUSTNESS.md "Signals and pipes").
 #pragma once
+
+#include <csignal>
 
 namespace mcrt {
 
-// Ignores SIGINT and SIGTERM for the rest of the process.
+// SIGINT (Ctrl-C), SIGTERM (kill, a batch system's end of a job) and SIGHUP (a closed terminal or
+// ssh session): each stops a render, which writes the samples done so far.
+inline constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
+// After every output is complete a stop signal has nothing left to save: the stop signals are
+// ignored for the rest of the process, so it still exits 0.
 void outputs_complete();
 
 // True once outputs_complete() ran: the render's interrupt guard must not restore the default

@@ -19,6 +19,7 @@
 #include "cl/device_select.h"
 #include "common/environment.h"
 #include "common/error.h"
+#include "common/stop_signals.h"
 #include "mpi/job.h"
 #include "mpi/mpi_comm.h"
 #include "mpi/remote_worker.h"
@@ -227,10 +228,9 @@ void serve_device(RenderWorker& worker, int slot) {
 
 int serve_render(const RenderRequest& request, const std::vector<std::string>& device_names) {
     // Rank 0 decides when the render stops (its signals, its time limit) and tells every rank;
-    // mpirun's SIGTERM to all ranks at Ctrl-C must not end this one before rank 0 has the
+    // mpirun's SIGTERM to all ranks at Ctrl-C (or a SIGHUP) must not end this one before rank 0 has the
     // samples it is rendering.
-    std::signal(SIGINT, SIG_IGN);
-    std::signal(SIGTERM, SIG_IGN);
+    for (int sig : kStopSignals) std::signal(sig, SIG_IGN);
 
     const uint64_t go = mpi::broadcast_u64(0, 0);
     if (go != 0) return int(go);
