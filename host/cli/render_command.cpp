@@ -153,6 +153,46 @@ InputError flag_error(const SettingError& e) {
     return InputError(flag + " " + e.detail);
 }
 
+std::vector<std::string> render_option_words(const RenderOptions& o) {
+    auto text = [](const char* name, const std::string& value) {
+        return value.empty() ? std::string("no ") + name : std::string(name) + " " + value;
+    };
+    auto number = [](const char* format, double v) {
+        char digits[40];
+        std::snprintf(digits, sizeof digits, format, v);
+        return std::string(digits);
+    };
+    auto flag = [](const char* name, bool on) { return (on ? "" : std::string("no ")) + name; };
+    return {"the scene " + o.scene,
+            text("--out", o.out),
+            text("--png", o.png),
+            text("--stats", o.stats),
+            "--width " + std::to_string(o.width),
+            "--height " + std::to_string(o.height),
+            "--spp " + std::to_string(o.spp),
+            "--estimator " + o.estimator,
+            text("--estimator-file", o.estimator_file),
+            "--light-select " + o.light_select,
+            "--sampler " + o.sampler,
+            "--mis-heuristic " + o.mis_heuristic,
+            "--materials " + o.materials,
+            "--seed " + std::to_string(o.seed),
+            text("--sky", o.sky),
+            "--max-depth " + std::to_string(o.max_depth),
+            "--rr-depth " + std::to_string(o.rr_depth),
+            "--ao-distance " + number("%.9g", o.ao_distance),
+            o.camera < 0 ? "no --camera" : "--camera " + std::to_string(o.camera),
+            text("--look-from", o.look.look_from),
+            text("--look-at", o.look.look_at),
+            "--up " + o.look.up,
+            "--fov " + number("%.9g", o.look.fov),
+            "--batch " + std::to_string(o.batch),
+            "--replicates " + std::to_string(o.replicates),
+            o.time_limit > 0 ? "--time-limit " + number("%.17g", o.time_limit) : "no --time-limit",
+            "--exposure " + number("%.9g", o.exposure),
+            flag("--quiet", o.quiet)};
+}
+
 CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
     CLI::App* cmd = app.add_subcommand("render", "render a glTF scene to EXR");
     cmd->add_option("scene", o.scene, "glTF scene (.gltf or .glb)")->required();

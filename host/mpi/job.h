@@ -28,6 +28,16 @@ class JobSession {
 int job_rank();  // this process's rank; 0 outside a job
 int job_size();  // processes in the job; 1 outside one
 
+// First thing after the command line is read, in a job of more than one rank: every rank's
+// reading of it against rank 0's, so that no rank renders with options of its own and none is
+// left waiting for a rank that refused its options (docs/MPI.md). `command` is this rank's
+// reading, one entry per option as it reads ("mcrt render", "--width 64", "no --png"; rank 0's
+// and every other rank's lists have the same length when they run the same subcommand);
+// `refused` is this rank's usage error, if any. Rank 0 prints one `mcrt: error:` line for the
+// lowest rank that refused its options or reads one differently (its own usage error is its
+// caller's to print). Returns the status every rank exits with: 0 when all agree, else 2.
+int agree_on_command(const std::vector<std::string>& command, const std::string& refused);
+
 // Rank 0's side of a render across the job: it sends the inputs, hands every other rank's devices
 // work items (RemoteWorker) beside its own, and tells the ranks how the command ended.
 class RenderJob {

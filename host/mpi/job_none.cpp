@@ -10,6 +10,7 @@ JobSession::JobSession() = default;
 JobSession::~JobSession() = default;
 int job_rank() { return 0; }
 int job_size() { return 1; }
+int agree_on_command(const std::vector<std::string>&, const std::string&) { return 0; }
 
 RenderJob::RenderJob() { throw RuntimeError("mcrt was built without MPI"); }
 RenderJob::~RenderJob() = default;
