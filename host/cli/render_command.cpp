@@ -43,8 +43,8 @@ volatile std::sig_atomic_t g_interrupted = 0;
 extern "C" void on_interrupt(int) { g_interrupted = 1; }
 
 // While a render runs, SIGINT, SIGTERM and SIGHUP (kStopSignals) ask it to stop and write the
-// samples done so far; a second signal ends the process at once. SIGHUP stays ignored where it
-// was (nohup).
+// samples done so far; a second signal ends the process at once. SIGHUP stays ignored where the
+// process started with it ignored (nohup).
 struct InterruptGuard {
     InterruptGuard() {
         g_interrupted = 0;
@@ -55,7 +55,7 @@ struct InterruptGuard {
         sigemptyset(&action.sa_mask);
         for (size_t i = 0; i < std::size(kStopSignals); ++i) {
             sigaction(kStopSignals[i], nullptr, &old[i]);
-            if (kStopSignals[i] == SIGHUP && old[i].sa_handler == SIG_IGN) continue;
+            if (ignored_at_start(kStopSignals[i])) continue;
             sigaction(kStopSignals[i], &action, nullptr);
         }
     }

@@ -4,7 +4,15 @@ namespace mcrt {
 
 namespace {
 volatile std::sig_atomic_t g_outputs_complete = 0;
-}
+
+// Read during static initialisation, before main and before any OpenCL library is loaded.
+const bool g_hangup_ignored = [] {
+    struct sigaction action {};
+    return sigaction(SIGHUP, nullptr, &action) == 0 && action.sa_handler == SIG_IGN;
+}();
+}  // namespace
+
+bool ignored_at_start(int sig) { return sig == SIGHUP && g_hangup_ignored; }
 
 void outputs_complete() {
     g_outputs_complete = 1;

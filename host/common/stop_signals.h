@@ -18,6 +18,11 @@ void outputs_complete();
 // (terminating) actions then.
 bool outputs_are_complete();
 
+// True when `sig` was ignored when the process started (SIGHUP under nohup), read before any
+// library could install a handler over it (LLVM, inside an OpenCL compiler, catches SIGHUP, SIGINT
+// and SIGTERM, and would hide that they were ignored).
+bool ignored_at_start(int sig);
+
 // SIGPIPE ignored (a closed stderr pipe makes writes fail, harmlessly, instead of killing the
 // process before the image is written); SIGXFSZ too, so a file-size limit is a write error.
 void ignore_pipe_signals();
