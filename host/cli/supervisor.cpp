@@ -181,6 +181,9 @@ std::string stuck_where(const WorkerStage& w, const std::string& of_what) {
         return "a launch on the devices did not return within " + grace +
                estimator_hint(w, "an estimator that does not return?",
                               "a kernel or an OpenCL driver that does not return");
+    if (w.command != "render")  // devices, bench, integrate: no stage reported
+        return "mcrt " + w.command + " did not stop within " + grace +
+               " (an OpenCL driver or kernel that does not return?)";
     return "the render did not stop within " + grace +
            " while setting up (loading the scene, building kernels, waiting for other ranks)";
 }
@@ -332,7 +335,8 @@ int supervise(const std::string& command, pid_t pid, int fd) {
             seconds_since(forwarded_at) > kSupervisorGraceSeconds) {
             kill_and_reap(pid, &status);
             print_error(w, "stopped by " + signal_abbreviation(forwarded) + ", but " +
-                               stuck_where(w, "") + "; no image was written");
+                               stuck_where(w, "") +
+                               (w.command == "render" ? "; no image was written" : "; it was killed"));
             return 1;
         }
         if (w.stage == Stage::kLaunch && w.time_limit > 0 &&
