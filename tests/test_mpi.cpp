@@ -317,6 +317,10 @@ TEST_CASE("bad input under mpirun: every rank exits 2, with one error line", "[m
         {"missing scene", {"render", dir / "none.gltf", "--out", dir / "x.exr"}},
         {"unknown option", {"render", kCornell, "--out", dir / "x.exr", "--no-such-option"}},
         {"bad camera", {"render", kCornell, "--out", dir / "x.exr", "--camera", "9"}},
+        // Read into the request after parsing: each rank reads them, rank 0 alone says so.
+        {"bad sky", {"render", kCornell, "--out", dir / "x.exr", "--sky", "abc"}},
+        {"bad look-from",
+         {"render", kCornell, "--out", dir / "x.exr", "--look-from", "1,2", "--look-at", "0,0,0"}},
         {"estimator that does not build",
          {"render", kCornell, "--out", dir / "x.exr", "--width", "8", "--height", "8",
           "--estimator-file", dir / "bad.cl"}},

@@ -389,7 +389,7 @@ int render_in_job(const RenderOptions& o) {
     if (job_rank() > 0) {
         if (!o.estimator_file.empty()) report_to_supervisor("estimator " + o.estimator_file);
         report_to_supervisor("serve");  // rank 0 decides when this rank stops
-        return serve_render(render_request(o), o.devices);
+        return serve_render([&] { return render_request(o); }, o.devices);
     }
     // Every rank exits with rank 0's status; its error line is printed by run_cli alone.
     RenderJob job;

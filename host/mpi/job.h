@@ -3,6 +3,7 @@
 // a job of one and renders as it always has.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -70,8 +71,11 @@ class RenderJob {
 // Every rank but 0: receives the inputs, sets up its devices, renders the items rank 0 hands
 // them until told to stop, and returns rank 0's exit status. Prints nothing: what goes wrong
 // here reaches rank 0 as a warning (a setup that fails, a device that fails) and its status.
-// `request` and `devices` are this rank's own reading of the command line (the same on every
-// rank); the scene and the estimator's text come from rank 0.
-int serve_render(const RenderRequest& request, const std::vector<std::string>& devices);
+// `make_request` and `devices` are this rank's own reading of the command line (the same on every
+// rank but --device: agree_on_command); the scene and the estimator's text come from rank 0.
+// The request is made only once rank 0 says go: a request rank 0 refused (a bad --sky) ends this
+// rank with rank 0's status and no line of its own.
+int serve_render(const std::function<RenderRequest()>& make_request,
+                 const std::vector<std::string>& devices);
 
 }  // namespace mcrt

@@ -309,7 +309,8 @@ void serve_device(RenderWorker& worker, int slot) {
 
 }  // namespace
 
-int serve_render(const RenderRequest& request, const std::vector<std::string>& device_names) {
+int serve_render(const std::function<RenderRequest()>& make_request,
+                 const std::vector<std::string>& device_names) {
     // Rank 0 decides when the render stops (its signals, its time limit) and tells every rank;
     // mpirun's SIGTERM to all ranks at Ctrl-C (or a SIGHUP) must not end this one before rank 0 has the
     // samples it is rendering.
@@ -328,7 +329,7 @@ int serve_render(const RenderRequest& request, const std::vector<std::string>& d
     std::vector<std::unique_ptr<DeviceWorker>> workers;
     try {
         FileBundle files;
-        RenderRequest r = request;
+        RenderRequest r = make_request();  // rank 0 made the same one: it said go
         wire::decode_inputs(bytes, files, r.settings.estimator_source);
         bytes = {};
         SceneSource source;
