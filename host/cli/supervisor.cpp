@@ -454,6 +454,7 @@ std::optional<int> supervise_command(int argc, char** argv) {
         for (int sig : kStopSignals)
             if (g_caught[sig]) std::signal(sig, SIG_DFL), g_caught[sig] = false;
         std::signal(SIGCHLD, SIG_DFL);
+        std::signal(SIGCONT, SIG_DFL);
         if (g_terminal_stop_caught) std::signal(SIGTSTP, SIG_DFL);
         if (const int sig = g_signal; sig != 0) std::raise(sig);
         return std::nullopt;
