@@ -1,6 +1,7 @@
 #include "cl/device.h"
 
 #include "cl/cl_error.h"
+#include "cl/no_device.h"
 #include "common/test_hooks.h"
 
 namespace mcrt {
@@ -24,6 +25,7 @@ static T device_info(const cl::Device& device) {
 }
 
 std::vector<DeviceInfo> enumerate_devices(const std::function<void(const std::string&)>& warn) {
+    check_icd_files();  // the loader would block or crash on them
     std::vector<cl::Platform> platforms;
     cl_int status = cl::Platform::get(&platforms);
     // The ICD loader answers CL_PLATFORM_NOT_FOUND_KHR (-1001) when no platform is installed.
