@@ -450,6 +450,19 @@ TEST_CASE("floating-point option values are refused with their true reason", "[c
         CHECK(r.err.find(std::string("--time-limit: ") + said) != std::string::npos);
         CHECK(box.files().empty());
     }
+    // A float option too: an --ao-distance that rounds to 0 in float would be "unbounded".
+    {
+        Sandbox box;
+        ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("x.exr"),
+                                          "--estimator", "ambient-uniform", "--ao-distance",
+                                          "1e-50"},
+                                         kSmall));
+        INFO(r.err);
+        check_usage_error(r);
+        CHECK(r.err.find("--ao-distance: '1e-50' is too small to tell from 0 (the smallest is "
+                         "1.4e-45)") != std::string::npos);
+        CHECK(box.files().empty());
+    }
     // The smallest positive double is a time limit: the render stops at its first check, with
     // its first chunk row (the supervisor is told the limit with every digit, not "0.000000").
     Sandbox box;

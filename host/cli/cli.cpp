@@ -105,7 +105,7 @@ CLI::App* add_bench_command(CLI::App& app, BenchOptions& o, CameraOptions& look)
     cmd->add_option("--bvh-traversal-cost", o.bvh.traversal_cost,
                     "SAH cost of a node visit, in packet tests")
         ->capture_default_str()
-        ->check(kFinite)
+        ->check(kFiniteFloat)
         ->check(CLI::Range(0.0f, 100.0f));
     return cmd;
 }

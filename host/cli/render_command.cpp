@@ -246,7 +246,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
         ->check(CLI::Range(1u, MCRT_MAX_PATH_DEPTH));
     cmd->add_option("--ao-distance", o.ao_distance, "ambient occlusion distance, 0 = unbounded")
         ->capture_default_str()
-        ->check(kFinite)
+        ->check(kFiniteFloat)
         ->check(CLI::Range(0.0f, 3.4e38f));
     CLI::Option* camera = cmd->add_option("--camera", o.camera, "glTF camera index in the scene (cameras[K])")
                               ->check(CLI::Range(0, 1 << 30));
@@ -267,7 +267,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
         ->check(CLI::Range(0.0, 1e9));
     cmd->add_option("--exposure", o.exposure, "PNG exposure in stops")
         ->capture_default_str()
-        ->check(kFinite)
+        ->check(kFiniteFloat)
         ->check(CLI::Range(-64.0f, 64.0f));
     cmd->add_flag("--quiet", o.quiet, "no progress output");
     return cmd;
