@@ -463,6 +463,22 @@ TEST_CASE("floating-point option values are refused with their true reason", "[c
                          "1.4e-45)") != std::string::npos);
         CHECK(box.files().empty());
     }
+    // A sky radiance below float's smallest is in [0, 1e30] (it rounds as any float does); a
+    // trailing comma is no value.
+    {
+        Sandbox box;
+        ProcessResult tiny = box.run(concat({"render", kCornell, "--out", box.out("x.exr"),
+                                             "--estimator", "ambient-uniform", "--sky", "1e-50"},
+                                            kSmall));
+        INFO(tiny.err);
+        CHECK(tiny.exit_code == 0);
+        ProcessResult comma = box.run(concat({"render", kCornell, "--out", box.out("y.exr"),
+                                              "--sky", "1,"},
+                                             kSmall));
+        INFO(comma.err);
+        check_usage_error(comma);
+        CHECK(comma.err.find("--sky 1,: expected R,G,B or one value") != std::string::npos);
+    }
     // The smallest positive double is a time limit: the render stops at its first check, with
     // its first chunk row (the supervisor is told the limit with every digit, not "0.000000").
     Sandbox box;

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <chrono>
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -72,16 +73,17 @@ glm::vec3 parse_sky(const std::string& text) {
     std::stringstream in(text);
     std::string item;
     while (std::getline(in, item, ',')) {
-        try {
-            size_t used = 0;
-            float x = std::stof(item, &used);
-            if (used != item.size() || !std::isfinite(x) || x < 0 || x > kMaxRadiance)
-                throw std::invalid_argument(item);
-            v.push_back(x);
-        } catch (const std::exception&) {
+        // Read as a double: std::stof refused a radiance below float's smallest (1e-50) as out
+        // of range though it is in [0, 1e30]; it rounds to 0 or a denormal, as any float does.
+        char* end = nullptr;
+        const double x = std::strtod(item.c_str(), &end);
+        if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(x) || x < 0 ||
+            x > kMaxRadiance)
             throw InputError("--sky " + text + ": expected R,G,B or one value, each in [0, 1e30]");
-        }
+        v.push_back(float(x));
     }
+    if (!text.empty() && text.back() == ',')  // getline drops the empty last value
+        throw InputError("--sky " + text + ": expected R,G,B or one value");
     if (v.size() == 1) return glm::vec3(v[0]);
     if (v.size() == 3) return glm::vec3(v[0], v[1], v[2]);
     throw InputError("--sky " + text + ": expected R,G,B or one value");
