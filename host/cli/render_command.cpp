@@ -73,14 +73,14 @@ glm::vec3 parse_sky(const std::string& text) {
     std::stringstream in(text);
     std::string item;
     while (std::getline(in, item, ',')) {
-        // Read as a double: std::stof refused a radiance below float's smallest (1e-50) as out
-        // of range though it is in [0, 1e30]; it rounds to 0 or a denormal, as any float does.
+        // Checked as a double: std::stof refused a radiance below float's smallest (1e-50) as
+        // out of range though it is in [0, 1e30]; as a float it is 0 or a denormal.
         char* end = nullptr;
         const double x = std::strtod(item.c_str(), &end);
         if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(x) || x < 0 ||
             x > kMaxRadiance)
             throw InputError("--sky " + text + ": expected R,G,B or one value, each in [0, 1e30]");
-        v.push_back(float(x));
+        v.push_back(std::strtof(item.c_str(), nullptr));  // rounded once, as std::stof did
     }
     if (!text.empty() && text.back() == ',')  // getline drops the empty last value
         throw InputError("--sky " + text + ": expected R,G,B or one value");
