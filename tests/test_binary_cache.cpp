@@ -1,8 +1,11 @@
 // The on-disk kernel binary cache: hits, misses, keys, and that it never fails a build.
 #include <catch2/catch.hpp>
 
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +17,7 @@
 #include "render/renderer.h"
 #include "render/variants.h"
 #include "cl/binary_cache.h"
+#include "cl/build_child.h"
 #include "cl/cl_error.h"
 #include "cl/program.h"
 #include "device_support.h"
@@ -406,4 +410,166 @@ TEST_CASE("cached_program stores the render kernel in the binary cache", "[cache
     build(device, kernel_source("render.cl"),
           default_render_options() + device_program_options(device.info), report);
     CHECK(report.cache_hit);
+}
+
+// The cache directory is the user's, but what lies in it may be planted: a link, a FIFO or a
+// directory named like an entry. The cache never writes through a link, never blocks on a FIFO,
+// and heals itself by removing what is not a regular file (a link's target stays untouched).
+TEST_CASE("the cache never follows, blocks on or keeps what is planted at an entry's name",
+          "[cache][hostile]") {
+    DeviceContext device = first_device();
+    TempCache cache;
+    fs::create_directories(cache.dir);
+    const fs::path victim_dir = cache.dir.parent_path() / (cache.dir.filename().string() + "-victim");
+    fs::create_directories(victim_dir);
+    struct RemoveVictims {
+        fs::path dir;
+        ~RemoveVictims() {
+            std::error_code ec;
+            fs::remove_all(dir, ec);
+        }
+    } remove_victims{victim_dir};
+    const fs::path victim = victim_dir / "precious.txt";
+    std::ofstream(victim) << "precious";
+    const std::string key = binary_cache_key(device.info, kSource, kOptions).hex();
+    const fs::path entry = cache.dir / (key + ".bin"), counter = cache.dir / (key + ".misses");
+
+    // Builds, then checks the entry is a regular file that hits.
+    auto build_and_heal = [&](int store_after_misses) {
+        BuildReport report;
+        cl::Program program = build_program_cached(device.context, device.info.device, device.info,
+                                                   kSource, kOptions, &report, store_after_misses);
+        check_runs(device, program, 2.0f, 1.0f);
+        CHECK_FALSE(report.cache_hit);
+        return report;
+    };
+    auto entry_hits = [&] {
+        CHECK(fs::symlink_status(entry).type() == fs::file_type::regular);
+        BuildReport again;
+        build(device, kSource, kOptions, again);
+        CHECK(again.cache_hit);
+    };
+
+    SECTION("a link to a file") {
+        fs::create_symlink(victim, entry);
+        const BuildReport r = build_and_heal(1);
+        CHECK_THAT(r.rejected, Catch::Contains("symbolic link"));
+        CHECK(r.store_error.empty());
+        entry_hits();
+    }
+    SECTION("a dangling link") {
+        const fs::path elsewhere = victim_dir / "created.bin";
+        fs::create_symlink(elsewhere, entry);
+        build_and_heal(1);
+        CHECK_FALSE(fs::exists(elsewhere));
+        entry_hits();
+    }
+    SECTION("a link at the miss counter") {
+        std::ofstream(victim, std::ios::trunc) << "7\n";
+        fs::create_symlink(victim, counter);
+        const BuildReport r = build_and_heal(3);
+        CHECK(r.store_deferred);
+        CHECK(fs::symlink_status(counter).type() == fs::file_type::regular);
+        CHECK(read_bytes(counter) == std::vector<char>{'1', '\n'});  // the link's 7 not read
+        std::ofstream(victim, std::ios::trunc) << "precious";
+    }
+    SECTION("a FIFO") {
+        REQUIRE(::mkfifo(entry.c_str(), 0644) == 0);
+        const BuildReport r = build_and_heal(1);  // open(2) on a FIFO would block forever
+        CHECK_THAT(r.rejected, Catch::Contains("FIFO"));
+        entry_hits();
+    }
+    SECTION("an empty directory") {
+        fs::create_directory(entry);
+        const BuildReport r = build_and_heal(1);
+        CHECK_THAT(r.rejected, Catch::Contains("directory"));
+        CHECK(r.store_error.empty());
+        entry_hits();
+    }
+    SECTION("a directory with files: the build works and the report says why nothing is stored") {
+        fs::create_directory(entry);
+        std::ofstream(entry / "user-file") << "mine";
+        const BuildReport r = build_and_heal(1);
+        CHECK_THAT(r.store_error, Catch::Contains("not empty"));
+        CHECK(read_bytes(entry / "user-file") == std::vector<char>{'m', 'i', 'n', 'e'});
+    }
+    CHECK(read_bytes(victim) == std::vector<char>{'p', 'r', 'e', 'c', 'i', 'o', 'u', 's'});
+    CHECK(fs::symlink_status(victim).type() == fs::file_type::regular);
+    for (const fs::path& file : cache.files())
+        CHECK(file.filename().string().find(".tmp-") == std::string::npos);
+}
+
+TEST_CASE("a stale temporary of a killed writer is swept from the cache directory", "[cache][hostile]") {
+    DeviceContext device = first_device();
+    TempCache cache;
+    fs::create_directories(cache.dir);
+    const std::string key = binary_cache_key(device.info, kSource, kOptions).hex();
+    // A PID that names no process: a child that has exited and been reaped.
+    const pid_t dead = ::fork();
+    if (dead == 0) ::_exit(0);
+    int status = 0;
+    REQUIRE(::waitpid(dead, &status, 0) == dead);
+    const fs::path stale = cache.dir / ("." + key + ".bin.tmp-" + std::to_string(dead) + "-0");
+    std::ofstream(stale) << "half a binary";
+    BuildReport report;
+    build(device, kSource, kOptions, report);
+    CHECK(report.store_error.empty());
+    CHECK_FALSE(fs::exists(stale));
+    CHECK(cache.files().size() == 1);
+}
+
+TEST_CASE("mcrt build-program run by hand replaces nothing and says why", "[cache][hostile]") {
+    const fs::path dir = fs::temp_directory_path() / ("mcrt-user-dir-" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    std::ofstream(dir / "binary") << "the user's";
+    std::ofstream(dir / "error") << "also the user's";
+    std::ofstream(dir / "source.cl") << kSource;
+    std::ofstream(dir / "options") << kOptions;
+    auto run = [](const std::string& arguments) {
+        const std::string command =
+            "'" + std::string(MCRT_EXE) + "' build-program " + arguments + " 2>&1";
+        std::string out;
+        FILE* pipe = ::popen(command.c_str(), "r");
+        REQUIRE(pipe != nullptr);
+        char buffer[512];
+        while (std::fgets(buffer, sizeof buffer, pipe)) out += buffer;
+        const int status = ::pclose(pipe);
+        return std::make_pair(WIFEXITED(status) ? WEXITSTATUS(status) : -1, out);
+    };
+    SECTION("a directory of the user's") {
+        const auto [code, out] = run("'" + dir.string() + "' 0");
+        CHECK(code == 2);
+        CHECK_THAT(out, Catch::StartsWith("mcrt: error: build-program: " + dir.string()));
+        CHECK_THAT(out, Catch::Contains("not a kernel build directory"));
+    }
+    SECTION("a missing directory") {
+        const auto [code, out] = run("'" + (dir / "missing").string() + "' 0");
+        CHECK(code == 2);
+        CHECK_THAT(out, Catch::Contains("No such file or directory"));
+    }
+    CHECK(read_bytes(dir / "binary") == std::vector<char>{'t', 'h', 'e', ' ', 'u', 's', 'e', 'r', '\'', 's'});
+    CHECK(read_bytes(dir / "error").size() == 15);
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+}
+
+TEST_CASE("a build directory left by a killed render is removed by the next child build",
+          "[cache][hostile]") {
+    const pid_t dead = ::fork();
+    if (dead == 0) ::_exit(0);
+    int status = 0;
+    REQUIRE(::waitpid(dead, &status, 0) == dead);
+    const fs::path stale = fs::temp_directory_path() / ("mcrt-build-" + std::to_string(dead) + "-a1B2c3");
+    fs::create_directories(stale);
+    std::ofstream(stale / "source.cl") << kSource;
+    // A directory of a live process (this one) under the same pattern stays.
+    const fs::path alive = fs::temp_directory_path() / ("mcrt-build-" + std::to_string(::getpid()) + "-zZ9yY8");
+    fs::create_directories(alive);
+    DeviceContext device = first_device();
+    const std::vector<unsigned char> binary = build_binary_in_child(device.info, kSource, kOptions);
+    CHECK_FALSE(binary.empty());
+    CHECK_FALSE(fs::exists(stale));
+    CHECK(fs::exists(alive));
+    std::error_code ec;
+    fs::remove_all(alive, ec);
 }

@@ -12,7 +12,11 @@
 #include <string>
 #include <vector>
 
+#include <zlib.h>
+
 #include "common/error.h"
+#include "image/jpeg_structure.h"
+#include "image/png_structure.h"
 #include "image_bytes.h"
 #include "scene/gltf_images.h"
 #include "scene/gltf_import.h"
@@ -48,6 +52,9 @@ struct TexturedGltf {
     std::string samplers;  // no "samplers" when empty
     std::string extra;     // more top-level properties, each followed by a comma
     size_t primitives = 1;
+    // The attributes of primitive k where given (its entry not empty), else all three.
+    std::vector<std::string> attributes;
+    std::vector<size_t> material_of;  // primitive k's material where given, else material k
     Bytes embedded;  // bytes after the geometry, as bufferView 4 (an image's)
 
     std::string text() const {
@@ -66,10 +73,13 @@ struct TexturedGltf {
                      std::to_string(embedded.size()) + "}";
         std::string prims;
         for (size_t k = 0; k < primitives; ++k) {
-            prims += std::string(k ? ", " : "") +
-                     R"({"attributes": {"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 2},
-                         "indices": 3, "material": )" +
-                     std::to_string(k) + "}";
+            const std::string attributes_k =
+                k < attributes.size() && !attributes[k].empty()
+                    ? attributes[k]
+                    : R"("POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 2)";
+            prims += std::string(k ? ", " : "") + R"({"attributes": {)" + attributes_k +
+                     R"(}, "indices": 3, "material": )" +
+                     std::to_string(k < material_of.size() ? material_of[k] : k) + "}";
         }
         return R"({"asset": {"version": "2.0"}, )" + extra +
                R"("scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
@@ -162,6 +172,51 @@ Bytes baseline_jpeg(int width, int height, const Bytes& texels) {
         },
         &out, width, height, 3, texels.data(), 100);
     return out;
+}
+
+// A PNG of `width` × `height` texels whose IDAT holds `stream` as it is (a zlib stream, valid or
+// not; CRCs right), `chunks` between IHDR and IDAT.
+Bytes png_with_stream(uint32_t width, uint32_t height, uint8_t depth, uint8_t colour_type,
+                      const Bytes& stream, const std::vector<Bytes>& chunks = {},
+                      bool interlaced = false) {
+    Bytes png = png_signature();
+    Bytes ihdr = png_ihdr(width, height, depth, colour_type);
+    if (interlaced) {  // the interlace byte, and the CRC again
+        ihdr[8 + 12] = 1;
+        Bytes data(ihdr.begin() + 8, ihdr.begin() + 21);
+        ihdr = png_chunk("IHDR", data);
+    }
+    for (const Bytes& chunk : std::vector<Bytes>{ihdr})
+        png.insert(png.end(), chunk.begin(), chunk.end());
+    for (const Bytes& chunk : chunks) png.insert(png.end(), chunk.begin(), chunk.end());
+    for (const Bytes& chunk : {png_chunk("IDAT", stream), png_chunk("IEND", {})})
+        png.insert(png.end(), chunk.begin(), chunk.end());
+    return png;
+}
+
+// `raw` deflated by zlib at its best compression.
+Bytes deflated(const Bytes& raw) {
+    uLongf size = compressBound(uLong(raw.size()));
+    Bytes out(size);
+    REQUIRE(compress2(out.data(), &size, raw.data(), uLong(raw.size()), 9) == Z_OK);
+    out.resize(size);
+    return out;
+}
+
+// The JPEG `jpeg` with its frame header (the first SOF0) edited: marker, precision, size.
+Bytes with_frame(Bytes jpeg, unsigned marker, unsigned precision, unsigned width, unsigned height) {
+    for (size_t at = 2; at + 9 < jpeg.size(); ++at) {
+        if (jpeg[at] != 0xFF || jpeg[at + 1] != 0xC0) continue;
+        jpeg[at + 1] = (unsigned char)marker;
+        jpeg[at + 4] = (unsigned char)precision;
+        jpeg[at + 5] = (unsigned char)(height >> 8);
+        jpeg[at + 6] = (unsigned char)height;
+        jpeg[at + 7] = (unsigned char)(width >> 8);
+        jpeg[at + 8] = (unsigned char)width;
+        return jpeg;
+    }
+    FAIL("no SOF0 in the JPEG");
+    return jpeg;
 }
 
 Bytes read_file(const std::string& path) {
@@ -280,7 +335,116 @@ TEST_CASE("texCoord 0 and 1 are read; other sets are refused", "[gltf][textures]
         R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 2}}}])";
     CHECK(contains(refusal(g), "material 0 baseColorTexture: texCoord 2 is not read"));
     g.materials = R"([{"emissiveTexture": {"index": 0, "texCoord": -1}}])";
-    CHECK(contains(refusal(g), "material 0 emissiveTexture: texCoord -1 is not read"));
+    CHECK(contains(refusal(g), "materials[0].emissiveTexture.texCoord: expected an integer from 0 "
+                               "to 2147483647, found -1"));
+}
+
+TEST_CASE("a texture on a TEXCOORD_n the primitive lacks is ignored there, with one warning",
+          "[gltf][textures]") {
+    // glTF 2.0 "Texture Data": a primitive MUST have the set its material's textures read. Read
+    // anyway, every corner would sample texel (0, 0).
+    TexturedGltf g;
+    g.attributes = {R"("POSITION": 0, "TEXCOORD_0": 1)"};  // no TEXCOORD_1
+    SECTION("each slot, its factor kept") {
+        const struct {
+            const char* material;
+            const char* slot;
+            TextureRef Material::*ref;
+        } slots[] = {
+            {R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1},
+                 "baseColorFactor": [0.5, 0.25, 1, 1]}})",
+             "baseColorTexture", &Material::base_color_texture},
+            {R"({"pbrMetallicRoughness": {"metallicRoughnessTexture": {"index": 0, "texCoord": 1},
+                 "baseColorFactor": [0.5, 0.25, 1, 1]}})",
+             "metallicRoughnessTexture", &Material::metallic_roughness_texture},
+            {R"({"normalTexture": {"index": 0, "texCoord": 1},
+                 "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 1, 1]}})",
+             "normalTexture", &Material::normal_texture},
+            {R"({"emissiveTexture": {"index": 0, "texCoord": 1}, "emissiveFactor": [1, 1, 1],
+                 "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 1, 1]}})",
+             "emissiveTexture", &Material::emissive_texture},
+        };
+        for (const auto& slot : slots) {
+            INFO(slot.slot);
+            g.materials = std::string("[") + slot.material + "]";
+            const Loaded l = load(g);
+            REQUIRE(l.warnings.size() == 1);
+            CHECK(contains(l.warnings[0], "textured.gltf: mesh 0 primitive 0: lacks the texture "
+                                          "coordinates that material 0 reads for " +
+                                              std::string(slot.slot) + " (TEXCOORD_1); ignored"));
+            REQUIRE(l.scene.triangle_material.size() == 1);
+            const Material& m = l.scene.materials[l.scene.triangle_material[0]];
+            CHECK_FALSE((m.*slot.ref).used());
+            CHECK(m.albedo == glm::vec3(0.5f, 0.25f, 1.0f));
+        }
+    }
+    SECTION("through KHR_texture_transform's texCoord, both ways") {
+        g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 0,
+                           "extensions": {"KHR_texture_transform": {"texCoord": 1}}}}}])";
+        Loaded l = load(g);
+        REQUIRE(l.warnings.size() == 1);
+        CHECK(contains(l.warnings[0], "baseColorTexture (TEXCOORD_1)"));
+        CHECK_FALSE(l.scene.materials[l.scene.triangle_material[0]].base_color_texture.used());
+        // The override names a set the primitive has: the texture stays.
+        g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1,
+                           "extensions": {"KHR_texture_transform": {"texCoord": 0}}}}}])";
+        l = load(g);
+        CHECK(l.warnings.empty());
+        CHECK(l.scene.materials[l.scene.triangle_material[0]].base_color_texture.used());
+    }
+    SECTION("a primitive without any texture coordinates, several slots named at once") {
+        g.attributes = {R"("POSITION": 0)"};
+        g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
+                           "normalTexture": {"index": 0}, "name": "Floor"}])";
+        const Loaded l = load(g);
+        REQUIRE(l.warnings.size() == 1);
+        CHECK(contains(l.warnings[0], "material 0 (\"Floor\") reads for baseColorTexture "
+                                      "(TEXCOORD_0), normalTexture (TEXCOORD_0); ignored"));
+        const Material& m = l.scene.materials[l.scene.triangle_material[0]];
+        CHECK_FALSE(m.base_color_texture.used());
+        CHECK_FALSE(m.normal_texture.used());
+        CHECK(m.name == "Floor");
+    }
+    SECTION("one material on primitives with and without the set: each sees its own") {
+        g.primitives = 3;
+        g.material_of = {0, 0, 0};
+        g.attributes = {"", R"("POSITION": 0, "TEXCOORD_0": 1)", R"("POSITION": 0)"};
+        g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}}}])";
+        const Loaded l = load(g);
+        REQUIRE(l.warnings.size() == 1);  // one warning for both primitives
+        CHECK(contains(l.warnings[0], "mesh 0 primitive 1: lacks"));
+        CHECK(contains(l.warnings[0], "; the same on 1 more primitive(s)"));
+        REQUIRE(l.scene.triangle_material.size() == 3);
+        CHECK(l.scene.materials[l.scene.triangle_material[0]].base_color_texture.used());
+        CHECK_FALSE(l.scene.materials[l.scene.triangle_material[1]].base_color_texture.used());
+        // The copy without the texture is made once, and shared.
+        CHECK(l.scene.materials.size() == 2);
+        CHECK(l.scene.triangle_material[2] == l.scene.triangle_material[1]);
+        CHECK(l.scene.images.size() == 1);
+    }
+    SECTION("instances of one primitive are one primitive in the warning") {
+        g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}}}])";
+        std::string text = g.text();
+        for (const auto& [from, to] :
+             {std::pair<std::string, std::string>{R"("scenes": [{"nodes": [0]}])", R"("scenes": [{"nodes": [0, 1]}])"},
+              {R"("nodes": [{"mesh": 0}])", R"("nodes": [{"mesh": 0}, {"mesh": 0, "translation": [0, 0, 1]}])"}}) {
+            const size_t at = text.find(from);
+            REQUIRE(at != std::string::npos);
+            text.replace(at, from.size(), to);
+        }
+        std::vector<std::string> warnings;
+        const Scene scene = load_gltf_from_memory("textured.gltf", Bytes(text.begin(), text.end()),
+                                                  [&](const std::string& w) { warnings.push_back(w); });
+        CHECK(scene.triangle_count() == 2);
+        REQUIRE(warnings.size() == 1);
+        CHECK_FALSE(contains(warnings[0], "more primitive"));
+    }
+    SECTION("an occlusion texture on a missing set: only the occlusion warning (it is not read)") {
+        g.materials = R"([{"occlusionTexture": {"index": 0, "texCoord": 1}}])";
+        const Loaded l = load(g);
+        REQUIRE(l.warnings.size() == 1);
+        CHECK(contains(l.warnings[0], "occlusionTexture is not used"));
+    }
 }
 
 TEST_CASE("KHR_texture_transform: T(offset) R(rotation) S(scale) and its texCoord, on every slot",
@@ -397,7 +561,7 @@ TEST_CASE("texture references: out of range refused, a texture without source wa
     g.textures = R"([{"source": 3}])";
     CHECK(contains(refusal(g), "texture 0: source image 3 out of range"));
     g.textures = R"([{"source": "0"}])";
-    CHECK(contains(refusal(g), "textures[0].source: expected an integer, found a string"));
+    CHECK(contains(refusal(g), "textures[0].source: expected an integer from 0 to 2147483647, found a string"));
     g.textures = "[{}]";
     const Loaded l = load(g);
     CHECK_FALSE(l.scene.materials[0].base_color_texture.used());
@@ -570,10 +734,111 @@ TEST_CASE("damaged or oversized images are refused with one line naming them",
                    contains(error, "does not start with a whole IHDR chunk")));
         }
     }
-    SECTION("a corrupt IDAT") {
-        Bytes broken = good;
-        broken[8 + 25 + 8 + 2] ^= 0xFF;  // the first stored block's header
-        CHECK(contains(decode({broken}).error, "image 0: the PNG cannot be decoded"));
+    SECTION("a damaged chunk: its CRC") {
+        // IDAT starts at byte 33, after the signature (8) and IHDR (25).
+        Bytes flipped = good;
+        flipped[33 + 8 + 2] ^= 0xFF;  // the first stored block's header
+        CHECK(contains(decode({flipped}).error, "image 0: PNG chunk IDAT at byte 33: CRC mismatch"));
+        flipped = good;
+        flipped[flipped.size() - 20] ^= 0x01;  // a texel's byte in the stored block
+        CHECK(contains(decode({flipped}).error, "PNG chunk IDAT at byte 33: CRC mismatch"));
+        // An ancillary chunk too: its bytes are as damaged as the others.
+        Bytes tagged = png_file(2, 8, 6, {{255, 0, 0, 255, 0, 0, 255, 128}},
+                                {png_chunk("gAMA", {0, 0, 0xB1, 0x8F})});
+        tagged[33 + 8] ^= 0x01;
+        CHECK(contains(decode({tagged}).error, "PNG chunk gAMA at byte 33: CRC mismatch"));
+        tagged[33 + 8] ^= 0x01;
+        CHECK(decode({tagged}).error.empty());
+    }
+    SECTION("damaged image data behind a right CRC: Adler-32, zlib, filter types") {
+        const Bytes raw = {0, 255, 0, 0, 255, 0, 0, 255, 128};  // one row, filter 0
+        Bytes stream = zlib_stored(raw);
+        CHECK(decode({png_with_stream(2, 1, 8, 6, stream)}).error.empty());
+        stream[7 + 3] ^= 0x10;  // a texel's byte in the stored block: only Adler-32 sees it
+        CHECK(contains(decode({png_with_stream(2, 1, 8, 6, stream)}).error,
+                       "image 0: the PNG's image data fails its Adler-32 check"));
+        stream = zlib_stored(raw);
+        stream[2 + 3] ^= 0xFF;  // the stored block's length check (NLEN)
+        CHECK(contains(decode({png_with_stream(2, 1, 8, 6, stream)}).error,
+                       "image 0: the PNG's IDAT data is not a valid zlib stream: invalid stored "
+                       "block lengths"));
+        stream = zlib_stored(raw);
+        stream.resize(stream.size() - 6);  // cut inside the stream
+        CHECK(contains(decode({png_with_stream(2, 1, 8, 6, stream)}).error,
+                       "the PNG's IDAT data ends inside its zlib stream"));
+        Bytes filter = raw;
+        filter[0] = 5;
+        CHECK(contains(decode({png_with_stream(2, 1, 8, 6, zlib_stored(filter))}).error,
+                       "image 0: the PNG's row 0 has filter type 5 (PNG defines 0 to 4)"));
+    }
+    SECTION("image data that inflates to more or less than the declared size needs") {
+        // 16 × 16 RGBA needs 16 × (1 + 64) = 1040 bytes. Followed by 8 MiB of zeros, which
+        // deflate to about 8 KiB, it would cost stb_image 8 MiB (1 GiB from 1 MB of IDAT); it is
+        // refused at the first 64 KiB past the size.
+        Bytes raw(16 * 65, 0);
+        Bytes more = raw;
+        more.resize(more.size() + (size_t(8) << 20), 0);
+        const Bytes bomb = png_with_stream(16, 16, 8, 6, deflated(more));
+        CHECK(bomb.size() < 20000);
+        CHECK(contains(decode({bomb}).error,
+                       "image 0: the PNG's IDAT data inflates beyond the 1040 bytes its 16 × 16 "
+                       "texels need"));
+        raw.resize(raw.size() - 65);
+        CHECK(contains(decode({png_with_stream(16, 16, 8, 6, deflated(raw))}).error,
+                       "image 0: the PNG's IDAT data inflates to 975 bytes; its 16 × 16 texels "
+                       "need 1040"));
+        raw.resize(raw.size() + 65);
+        CHECK(decode({png_with_stream(16, 16, 8, 6, deflated(raw))}).error.empty());
+    }
+    SECTION("palette indices beyond the palette, through every filter and interlaced") {
+        const Bytes palette = png_chunk("PLTE", {10, 20, 30, 40, 50, 60});  // 2 colours
+        // 8-bit indices 0 1 1 0, then 1 1 1 1 stored with the Sub filter (deltas 1 0 0 0).
+        const Bytes ok = {0, 0, 1, 1, 0, 1, 1, 0, 0, 0};
+        const Decoded d = decode({png_with_stream(4, 2, 8, 3, zlib_stored(ok), {palette})});
+        INFO(d.error);
+        REQUIRE(d.error.empty());
+        CHECK(d.images[0].rgba[4 * 5] == 40);
+        for (unsigned filter = 0; filter <= 4; ++filter) {
+            INFO("filter " << filter);
+            // Row 0 indices 0 1 1 0; row 1 indices 1 1 2 1 written with `filter`.
+            const Bytes row0 = {0, 1, 1, 0}, target = {1, 1, 2, 1};
+            Bytes stored = {0, 0, 1, 1, 0, (unsigned char)filter};
+            for (size_t i = 0; i < 4; ++i) {
+                const int a = i ? target[i - 1] : 0, b = row0[i], c = i ? row0[i - 1] : 0;
+                const int p = a + b - c, pa = std::abs(p - a), pb = std::abs(p - b),
+                          pc = std::abs(p - c);
+                const int predictor[5] = {0, a, b, (a + b) / 2,
+                                          pa <= pb && pa <= pc ? a : pb <= pc ? b : c};
+                stored.push_back((unsigned char)(target[i] - predictor[filter]));
+            }
+            CHECK(contains(decode({png_with_stream(4, 2, 8, 3, zlib_stored(stored), {palette})}).error,
+                           "image 0: the PNG's texel (2, 1) has palette index 2, beyond its "
+                           "2-colour palette"));
+        }
+        // 2-bit indices, packed: 0 1 3 0 in one byte (0b00011100).
+        CHECK(contains(decode({png_with_stream(4, 1, 2, 3, zlib_stored({0, 0x1C}), {palette})}).error,
+                       "texel (2, 0) has palette index 3"));
+        // The padding bits of a row's last byte are not texels: 0 1 in the top 4 bits, 3 3 after.
+        CHECK(decode({png_with_stream(2, 1, 2, 3, zlib_stored({0, 0x1F}), {palette})}).error.empty());
+        // Adam7: 3 × 3 texels in passes 1 (0, 0), 2 none, 3 none, 4 (2, 0), 5 none... per PNG
+        // 8.2: pass 1 texel (0,0); pass 4 (2,0); pass 5 (0,2),(2,2); pass 6 (1,0),(1,2); pass 7
+        // row 1: (0,1),(1,1),(2,1). Index 2 at (1, 1), in pass 7.
+        const Bytes interlaced = {0, 0,  0, 0,  0, 0, 0,  0, 0,  0, 0,  0, 1, 2, 1};
+        CHECK(contains(decode({png_with_stream(3, 3, 8, 3, zlib_stored(interlaced), {palette}, true)}).error,
+                       "the PNG's texel (1, 1) has palette index 2"));
+        Bytes fine = interlaced;
+        fine[13] = 1;
+        const Decoded adam7 = decode({png_with_stream(3, 3, 8, 3, zlib_stored(fine), {palette}, true)});
+        REQUIRE(adam7.error.empty());
+        CHECK(adam7.images[0].rgba[4 * 4] == 40);  // texel (1, 1): colour 1
+        CHECK(adam7.images[0].rgba[4 * 3] == 40);  // texel (0, 1)
+        CHECK(adam7.images[0].rgba[0] == 10);      // texel (0, 0): colour 0
+    }
+    SECTION("IHDR fields PNG does not define, a palette image without PLTE") {
+        CHECK(contains(decode({png_with_stream(1, 1, 3, 2, zlib_stored({0, 0}))}).error,
+                       "the PNG's IHDR declares colour type 2 with bit depth 3"));
+        CHECK(contains(decode({png_with_stream(1, 1, 8, 3, zlib_stored({0, 0}))}).error,
+                       "the PNG is a palette image without a PLTE chunk"));
     }
     SECTION("an unknown critical chunk, or none of IHDR first") {
         Bytes odd = png_signature();
@@ -596,6 +861,12 @@ TEST_CASE("damaged or oversized images are refused with one line naming them",
         CHECK(contains(decode({png_header_only(4096, 4096, 100)}).error,
                        "image 0: the PNG's 100 bytes of IDAT data cannot hold the 4096 × 4096 "
                        "texels it declares"));
+        // 16-bit RGBA at 16384²: stb_image's image buffer would pass 2 GiB, which it refuses
+        // only after inflating (and under another decoder's error).
+        CHECK(contains(decode({png_with_stream(16384, 16384, 16, 6, Bytes(2100000, 0))}).error,
+                       "image 0: 16384 × 16384 texels of 16-bit samples need a buffer of "
+                       "2147500032 bytes, more than the 2 GiB stb_image (mcrt's decoder) "
+                       "allocates at once"));
         // Four 16384² images are 2^30 texels, the budget; a fifth, even 1×1, is over it. (Each
         // IDAT is just long enough to pass for 1 GiB of deflated samples: never decoded.)
         std::vector<Bytes> five(4, png_header_only(16384, 16384, 1100000));
@@ -613,6 +884,57 @@ TEST_CASE("damaged or oversized images are refused with one line naming them",
         jpeg.resize(jpeg.size() / 2);
         CHECK(contains(decode({jpeg}).error, "image 0: the JPEG cannot be decoded"));
     }
+    SECTION("a JPEG whose frame declares more texels than its bytes can hold") {
+        const Bytes small = baseline_jpeg(8, 8, Bytes(3 * 64, 90));
+        const Bytes lying = with_frame(small, 0xC0, 8, 8192, 8192);
+        CHECK(contains(decode({lying}).error,
+                       "image 0: the JPEG's " + std::to_string(lying.size()) +
+                           " bytes cannot hold the 8192 × 8192 texels it declares: its 3145728 "
+                           "blocks of 8 × 8 need at least 393216 (a bit each)"));
+        CHECK(contains(decode({with_frame(small, 0xC0, 8, 16384, 16384)}).error,
+                       "cannot hold the 16384 × 16384 texels"));
+        CHECK(contains(decode({with_frame(small, 0xC0, 8, 20000, 8)}).error,
+                       "20000 × 8 texels: more than the 16384 per side"));
+        // A real 1024 × 1024 JPEG of one colour is about 100 KiB against 49152 bytes at least.
+        const Bytes flat = baseline_jpeg(1024, 1024, Bytes(3 * 1024 * 1024, 90));
+        INFO("flat JPEG of " << flat.size() << " bytes");
+        const Decoded d = decode({flat});
+        CHECK(d.error.empty());
+    }
+    SECTION("JPEG codings stb_image lacks are named, not called corrupt") {
+        const Bytes small = baseline_jpeg(8, 8, Bytes(3 * 64, 90));
+        const struct {
+            unsigned marker, precision;
+            const char* why;
+        } codings[] = {
+            {0xC1, 12, "the JPEG has 12-bit samples (SOF1), which the decoder mcrt uses (stb_image) "
+                       "reads baseline and progressive Huffman JPEG of 8-bit samples only"},
+            {0xC2, 12, "12-bit samples (SOF2)"},
+            {0xC3, 8, "the JPEG is lossless (SOF3), a coding that the decoder mcrt uses (stb_image) "
+                      "reads baseline and progressive Huffman JPEG of 8-bit samples"},
+            {0xC5, 8, "hierarchical (differential sequential) (SOF5)"},
+            {0xC7, 16, "hierarchical lossless (SOF7)"},
+            {0xC9, 8, "arithmetic-coded (extended sequential) (SOF9)"},
+            {0xCA, 8, "arithmetic-coded progressive (SOF10)"},
+            {0xCB, 8, "arithmetic-coded lossless (SOF11)"},
+        };
+        for (const auto& c : codings) {
+            INFO(c.why);
+            const std::string error = decode({with_frame(small, c.marker, c.precision, 8, 8)}).error;
+            CHECK(contains(error, "image 0: the JPEG "));
+            CHECK(contains(error, c.why));
+            CHECK_FALSE(contains(error, "corrupt"));
+        }
+        // A DAC segment (arithmetic conditioning) before the frame.
+        Bytes dac = {0xFF, 0xD8, 0xFF, 0xCC, 0x00, 0x04, 0x00, 0x10};
+        dac.insert(dac.end(), small.begin() + 2, small.end());
+        CHECK(contains(decode({dac}).error, "the JPEG is arithmetic-coded (a DAC marker)"));
+        // The height in a DNL marker after the first scan: named too.
+        CHECK(contains(decode({with_frame(small, 0xC0, 8, 8, 0)}).error,
+                       "the JPEG's height comes after its first scan (a DNL marker)"));
+        // Extended sequential Huffman of 8-bit samples is read (stb_image decodes SOF1 as SOF0).
+        CHECK(decode({with_frame(small, 0xC1, 8, 8, 8)}).error.empty());
+    }
     SECTION("of several bad images the first in slot order is reported, whatever the threads") {
         Bytes cut = good;
         cut.resize(30);
@@ -621,13 +943,65 @@ TEST_CASE("damaged or oversized images are refused with one line naming them",
             CHECK(contains(decode(files, {2, 1, 0}, threads).error, "image 2:"));
             CHECK(contains(decode(files, {1, 0, 2}, threads).error, "image 0:"));
         }
-        // Decoding failures too (both pass the header checks).
-        Bytes broken = good;
-        broken[8 + 25 + 8 + 2] ^= 0xFF;
+        // Decoding failures too (both pass the header checks): image data behind a right CRC
+        // that fails its Adler-32.
+        Bytes stream = zlib_stored({0, 255, 0, 0, 255, 0, 0, 255, 128});
+        stream[7 + 3] ^= 0x10;
+        const Bytes broken = png_with_stream(2, 1, 8, 6, stream);
         for (unsigned threads : {1u, 3u}) {
             CHECK(contains(decode({good, broken, broken}, {0, 2, 1}, threads).error, "image 2:"));
         }
     }
+}
+
+TEST_CASE("PNG scanline bytes: Adam7 passes counted texel by texel; JPEG blocks by sampling",
+          "[textures][png][jpeg]") {
+    // Adam7 (PNG 8.2): the pass of texel (x, y), from the 8 × 8 pattern.
+    const int pattern[8][8] = {{1, 6, 4, 6, 2, 6, 4, 6}, {7, 7, 7, 7, 7, 7, 7, 7},
+                               {5, 6, 5, 6, 5, 6, 5, 6}, {7, 7, 7, 7, 7, 7, 7, 7},
+                               {3, 6, 4, 6, 3, 6, 4, 6}, {7, 7, 7, 7, 7, 7, 7, 7},
+                               {5, 6, 5, 6, 5, 6, 5, 6}, {7, 7, 7, 7, 7, 7, 7, 7}};
+    for (uint32_t w : {1u, 2u, 3u, 5u, 8u, 13u}) {
+        for (uint32_t h : {1u, 2u, 4u, 7u, 9u}) {
+            for (unsigned depth : {1u, 2u, 8u, 16u}) {
+                PngLayout layout;
+                layout.width = w;
+                layout.height = h;
+                layout.depth = uint8_t(depth);
+                layout.colour_type = depth == 16 ? 6 : 0;
+                const uint64_t bits = png_bits_per_texel(layout);
+                CHECK(png_filtered_bytes(layout) == h * (1 + (w * bits + 7) / 8));
+                // Each pass: its rows (those holding any of its texels), each of its texels.
+                uint64_t expected = 0;
+                for (int pass = 1; pass <= 7; ++pass) {
+                    uint64_t columns = 0, rows = 0;
+                    std::vector<uint64_t> per_row(h, 0);
+                    for (uint32_t y = 0; y < h; ++y)
+                        for (uint32_t x = 0; x < w; ++x) per_row[y] += pattern[y % 8][x % 8] == pass;
+                    for (uint32_t y = 0; y < h; ++y) {
+                        if (per_row[y] == 0) continue;
+                        ++rows;
+                        columns = per_row[y];  // the same in every row of a pass
+                    }
+                    if (rows > 0) expected += rows * (1 + (columns * bits + 7) / 8);
+                }
+                layout.interlaced = true;
+                INFO(w << " × " << h << " at " << depth << " bits");
+                CHECK(png_filtered_bytes(layout) == expected);
+            }
+        }
+    }
+    // JPEG 4:2:0 (Y sampled 2 × 2): a 17 × 9 image is 3 × 2 blocks of Y (its texels) and 2 × 1 of
+    // each chroma; padded to whole 16 × 16 MCUs, 32 × 16 samples of Y and 16 × 8 of each chroma.
+    Bytes frame = {0xFF, 0xD8, 0xFF, 0xC0, 0, 17, 8, 0, 9, 0, 17, 3,
+                   1, 0x22, 0, 2, 0x11, 1, 3, 0x11, 1};
+    JpegFrame parsed;
+    REQUIRE(read_jpeg_frame(frame.data(), frame.size(), parsed).empty());
+    CHECK(parsed.width == 17);
+    CHECK(parsed.height == 9);
+    CHECK(parsed.blocks == 3 * 2 + 2 * (2 * 1));
+    CHECK(jpeg_min_bytes(parsed) == 2);
+    CHECK(parsed.padded_samples == 32 * 16 + 2 * (16 * 8));
 }
 
 TEST_CASE("the textured sample scenes load with every used image decoded",

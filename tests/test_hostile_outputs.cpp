@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "common/atomic_file.h"
 #include "common/output_paths.h"
@@ -493,5 +494,77 @@ TEST_CASE("two renders into the same outputs leave one render's whole set", "[ou
     const auto stats = nlohmann::json::parse(read_whole_file(dir / "a.json"));
     CHECK(exr_attribute(dir / "a.exr", "mcrt.seed") == "2");
     CHECK(stats["seed"] == 2);
+    CHECK(names_in(dir.path()) == std::vector<std::string>{"a.exr", "a.json"});
+}
+
+TEST_CASE("one directory named two ways does not deadlock the commit", "[outputs][hostile]") {
+    // flock(2) locks belong to an open file description: a directory opened once per spelling
+    // would wait on its own lock forever. Each case must end, with every output written.
+    TempDir temp("mcrt-hostile"), logs("mcrt-hostile-logs");
+    const fs::path dir = temp.path();
+    fs::create_directory(dir / "out");
+    fs::create_directory_symlink(dir / "out", dir / "alias");
+    const std::string mcrt = std::string(MCRT_EXE), scene = kCornell;
+    const std::string render = "exec '" + mcrt + "' render '" + scene +
+                               "' --width 8 --height 8 --spp 16 --quiet ";
+    std::string command;
+    std::vector<fs::path> written;
+    SECTION("relative and absolute") {
+        command = "cd '" + dir.string() + "/out' && " + render + "--out o.exr --stats '" +
+                  (dir / "out" / "s.json").string() + "'";
+        written = {dir / "out" / "o.exr", dir / "out" / "s.json"};
+    }
+    SECTION("a dot component") {
+        command = "cd '" + dir.string() + "' && " + render +
+                  "--out out/a.exr --png out/./a.png";
+        written = {dir / "out" / "a.exr", dir / "out" / "a.png"};
+    }
+    SECTION("a linked directory") {
+        command = render + "--out '" + (dir / "out" / "a.exr").string() + "' --stats '" +
+                  (dir / "alias" / "a.json").string() + "'";
+        written = {dir / "out" / "a.exr", dir / "out" / "a.json"};
+    }
+    SECTION("/dev/stdout redirected to a file beside a relative --out") {
+        fs::create_symlink("/proc/self/fd/1", dir / "stdout");  // as /dev/stdout is
+        command = "cd '" + dir.string() + "/out' && " + render + "--out o.exr --stats '" +
+                  (dir / "stdout").string() + "' > s.json";
+        written = {dir / "out" / "o.exr", dir / "out" / "s.json"};
+    }
+    const ProcessResult r = run_process("/bin/sh", {"-c", command}, logs.path(), 60);
+    INFO(command << "\n" << r.err);
+    REQUIRE_FALSE(r.timed_out);
+    REQUIRE(r.exit_code == 0);
+    for (const fs::path& file : written) {
+        INFO(file);
+        CHECK(fs::file_size(file) > 0);
+    }
+    for (const std::string& name : names_in(dir / "out")) CHECK(name.find(".tmp-") == std::string::npos);
+}
+
+TEST_CASE("a stop signal while another render commits into the same directory ends the wait",
+          "[outputs][hostile][signals]") {
+    // Render 1 holds the directory's lock inside its commit; render 2, waiting for it, is sent
+    // SIGTERM: it ends with one error line and no temporary, and render 1 still lands its set.
+    TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
+    auto args = [&](const std::string& name) {
+        std::vector<std::string> a = with(small_render(dir / (name + ".exr")), {"--stats", dir / (name + ".json")});
+        a.insert(a.begin(), MCRT_EXE);
+        return a;
+    };
+    Child first(args("a"), {"MCRT_TEST_PAUSE=commit", "MCRT_TEST_PAUSE_UNTIL=" + (logs / "go")}, logs / "log1");
+    REQUIRE(first.wait_for_text("paused at commit", 60));
+    Child second(args("b"), {"MCRT_TEST_PAUSE=commit-wait", "MCRT_TEST_PAUSE_SECONDS=0"}, logs / "log2");
+    REQUIRE(second.wait_for_text("paused at commit-wait", 60));
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));  // into flock(2)
+    second.signal(SIGTERM);
+    const int status2 = second.wait(30);
+    INFO(second.output());
+    CHECK_FALSE(second.timed_out());
+    CHECK((WIFEXITED(status2) && WEXITSTATUS(status2) == 1));
+    CHECK(lines_starting_with(second.output(), "mcrt: error:").size() == 1);
+    CHECK(second.output().find("stopped while another process was writing its outputs") != std::string::npos);
+    write_text(logs / "go", "");
+    const int status1 = first.wait(60);
+    CHECK((WIFEXITED(status1) && WEXITSTATUS(status1) == 0));
     CHECK(names_in(dir.path()) == std::vector<std::string>{"a.exr", "a.json"});
 }

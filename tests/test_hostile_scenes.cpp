@@ -3,6 +3,7 @@
 // render) naming the cause; what is accepted with a warning warns once. Cases that hung or crashed the old loader
 // run through the mcrt executable, so that a regression fails the test instead of hanging it.
 #include <sys/stat.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -232,6 +233,26 @@ TEST_CASE("textured scenes with damaged images or references are refused in one 
     require_render_refused(
         scene_with("image_range.gltf", R"([{"uri": "good.png"}])", R"([{"source": 1}])"),
         "texture 0: source image 1 out of range");
+    // A damaged byte (the texel of a stored block): named by its chunk's CRC.
+    std::vector<unsigned char> damaged = png;
+    damaged[33 + 8 + 7 + 1] ^= 0x01;
+    write_text(dir / "damaged.png", std::string(damaged.begin(), damaged.end()));
+    require_render_refused(scene_with("damaged.gltf", R"([{"uri": "damaged.png"}])"),
+                           "image 0 (damaged.png): PNG chunk IDAT at byte 33: CRC mismatch");
+    // 1 × 1 declared, 64 MiB of zeros deflated to 64 KiB: refused before stb_image inflates it.
+    std::vector<unsigned char> zeros(size_t(64) << 20, 0);
+    uLongf deflated_size = compressBound(uLong(zeros.size()));
+    std::vector<unsigned char> deflated(deflated_size);
+    REQUIRE(compress2(deflated.data(), &deflated_size, zeros.data(), uLong(zeros.size()), 9) == Z_OK);
+    deflated.resize(deflated_size);
+    std::vector<unsigned char> bomb = png_signature();
+    for (const std::vector<unsigned char>& chunk :
+         {png_ihdr(1, 1, 8, 0), png_chunk("IDAT", deflated), png_chunk("IEND", {})})
+        bomb.insert(bomb.end(), chunk.begin(), chunk.end());
+    write_text(dir / "bomb.png", std::string(bomb.begin(), bomb.end()));
+    require_render_refused(scene_with("bomb.gltf", R"([{"uri": "bomb.png"}])"),
+                           "image 0 (bomb.png): the PNG's IDAT data inflates beyond the 2 bytes "
+                           "its 1 × 1 texels need");
     // A KTX2 image (KHR_texture_basisu's): named by its extension.
     const std::string ktx2 = "\xABKTX 20\xBB\r\n\x1A\n" + std::string(52, '\0');
     write_text(dir / "image.ktx2", ktx2);
@@ -297,7 +318,7 @@ TEST_CASE("silently wrong input is refused or warned about once", "[gltf][hostil
     SECTION("wrong JSON types of known properties") {
         Gltf g;
         g.nodes = R"([{"mesh": "0"}])";
-        CHECK(refusal(g).find("nodes[0].mesh: expected an integer, found a string") != std::string::npos);
+        CHECK(refusal(g).find("nodes[0].mesh: expected an integer from 0 to 2147483647, found a string") != std::string::npos);
         Gltf m;
         m.material = R"({"pbrMetallicRoughness": {"baseColorFactor": "red"}})";
         CHECK(refusal(m).find("baseColorFactor: expected an array of numbers") != std::string::npos);
@@ -345,6 +366,143 @@ TEST_CASE("silently wrong input is refused or warned about once", "[gltf][hostil
         Gltf fine;
         fine.size = 1e6;
         CHECK(load(fine).warnings.empty());
+    }
+}
+
+// ---- indices that wrap: integers beyond what tinygltf keeps them in ---------------------------
+
+// `text` with its first `from` replaced by `to` (which must be there), loaded from memory: the
+// refusal, or "(loaded)".
+std::string refusal_of_edit(const std::string& text, const std::string& from, const std::string& to) {
+    std::string edited = text;
+    const size_t at = edited.find(from);
+    REQUIRE(at != std::string::npos);
+    edited.replace(at, from.size(), to);
+    try {
+        load_gltf_from_memory("test.gltf", std::vector<unsigned char>(edited.begin(), edited.end()),
+                              [](const std::string&) {});
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "(loaded)";
+}
+
+TEST_CASE("integers that tinygltf would wrap, drop or turn negative are refused naming them",
+          "[gltf][hostile]") {
+    // tinygltf 2.7 casts an integer property to int (2^32 + 1 reads as 1, another valid index),
+    // reads a size_t property written negative or as 4.0 as absent, and keeps an extension's
+    // integers in an int: each must be refused before it parses, naming the property.
+    Gltf two;  // two materials, so that a wrapped material index lands on a valid one
+    two.material = R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}},
+                      {"emissiveFactor": [1, 1, 1]})";
+    const std::string text = two.text();
+    REQUIRE(refusal_of_edit(text, R"("material": 0)", R"("material": 1)") == "(loaded)");
+    struct Case {
+        const char* from;
+        const char* to;
+        const char* needle;
+    };
+    const Case cases[] = {
+        {R"("material": 0)", R"("material": 4294967297)",
+         "meshes[0].primitives[0].material: expected an integer from 0 to 2147483647, found 4294967297"},
+        {R"("material": 0)", R"("material": -1)", "primitives[0].material: expected an integer from 0"},
+        {R"("material": 0)", R"("material": 1.0)", "primitives[0].material: expected an integer from 0 to 2147483647, found 1.0"},
+        {R"("material": 0)", R"("material": 18446744073709551617)", "primitives[0].material: expected an integer"},
+        {R"("indices": 1)", R"("indices": 4294967297)", "primitives[0].indices: expected an integer from 0"},
+        {R"("POSITION": 0)", R"("POSITION": 4294967296)", "primitives[0].attributes.POSITION: expected an integer from 0"},
+        {R"({"mesh": 0})", R"({"mesh": 4294967296})", "nodes[0].mesh: expected an integer from 0 to 2147483647, found 4294967296"},
+        {R"({"mesh": 0})", R"({"mesh": 0, "camera": 4294967296})", "nodes[0].camera: expected an integer from 0"},
+        {R"({"mesh": 0})", R"({"mesh": 0, "skin": -4294967296})", "nodes[0].skin: expected an integer from 0"},
+        {R"({"mesh": 0})", R"({"mesh": 0, "children": [4294967297]})", "nodes[0].children[0]: expected an integer from 0"},
+        {R"("nodes": [0])", R"("nodes": [4294967296])", "scenes[0].nodes[0]: expected an integer from 0"},
+        {R"("scene": 0)", R"("scene": 4294967296)", "glTF.scene: expected an integer from 0"},
+        {R"({"bufferView": 0, "componentType": 5126)", R"({"bufferView": 4294967296, "componentType": 5126)",
+         "accessors[0].bufferView: expected an integer from 0"},
+        {R"({"bufferView": 0, "componentType": 5126)", R"({"bufferView": 0, "byteOffset": -12, "componentType": 5126)",
+         "accessors[0].byteOffset: expected a non-negative integer, found -12"},
+        {R"("componentType": 5126)", R"("componentType": 5126.0)", "accessors[0].componentType: expected a non-negative integer, found 5126.0"},
+        {R"("buffer": 0, "byteOffset": 0)", R"("buffer": 4294967296, "byteOffset": 0)", "bufferViews[0].buffer: expected an integer from 0"},
+        {R"("buffer": 0, "byteOffset": 0)", R"("buffer": 0, "byteStride": 12.0, "byteOffset": 0)", "bufferViews[0].byteStride: expected a non-negative integer"},
+        {R"("buffer": 0, "byteOffset": 0)", R"("buffer": 0, "target": 4294967296, "byteOffset": 0)",
+         "bufferViews[0].target: expected an integer from -2147483648 to 2147483647"},
+        {R"("indices": 1)", R"("indices": 1, "mode": 4294967300)", "primitives[0].mode: expected an integer from -2147483648"},
+        {R"("indices": 1)", R"("indices": 1, "targets": [{"POSITION": 4294967296}])", "primitives[0].targets[0].POSITION: expected an integer from 0"},
+        {R"("scene": 0,)", R"("scene": 0, "skins": [{"joints": [0, 4294967296]}],)", "skins[0].joints[1]: expected an integer from 0"},
+        {R"("scene": 0,)", R"("scene": 0, "animations": [{"channels": [{"sampler": 0, "target": {"node": 4294967296}}]}],)",
+         "animations[0].channels[0].target.node: expected an integer from 0"},
+        {R"("scene": 0,)", R"("scene": 0, "textures": [{"source": 4294967296}],)", "textures[0].source: expected an integer from 0"},
+        {R"("scene": 0,)", R"("scene": 0, "textures": [{"sampler": 4294967296}],)", "textures[0].sampler: expected an integer from 0"},
+        {R"("scene": 0,)", R"("scene": 0, "images": [{"bufferView": 4294967296}],)", "images[0].bufferView: expected an integer from 0"},
+        {R"("scene": 0,)", R"("scene": 0, "samplers": [{"wrapS": 4294977793}],)", "samplers[0].wrapS: expected an integer from -2147483648"},
+        {R"("scene": 0,)", R"("scene": 0, "samplers": [{"magFilter": 4294976025}],)", "samplers[0].magFilter: expected an integer"},
+        {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}})",
+         R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 4294967296}}})",
+         "materials[0].pbrMetallicRoughness.baseColorTexture.index: expected an integer from 0"},
+        {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}})",
+         R"({"normalTexture": {"index": 0, "texCoord": 4294967297}})",
+         "materials[0].normalTexture.texCoord: expected an integer from 0 to 2147483647, found 4294967297"},
+        {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}})",
+         R"({"emissiveTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"texCoord": 4294967296}}}})",
+         "materials[0].emissiveTexture.extensions.KHR_texture_transform.texCoord: expected an integer from 0"},
+        {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}})",
+         R"({"occlusionTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"offset": [0, 4294967296]}}}})",
+         "materials[0].occlusionTexture.extensions.KHR_texture_transform.offset[1]: expected a number, as an "
+         "integer from -2147483648 to 2147483647"},
+        {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}})",
+         R"({"emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4294967297}}})",
+         "materials[0].extensions.KHR_materials_emissive_strength.emissiveStrength: expected a number"},
+        {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}})",
+         R"({"extensions": {"KHR_materials_specular": {"specularColorFactor": [1, 1, -4294967295]}}})",
+         "KHR_materials_specular.specularColorFactor[2]: expected a number"},
+        {R"("byteLength": 36})", R"("byteLength": -36})", "bufferViews[0].byteLength: expected a non-negative integer"},
+    };
+    SECTION("every index, count and enumeration tinygltf parses, in the core and in extensions") {
+        for (const Case& c : cases) {
+            INFO(c.to);
+            const std::string why = refusal_of_edit(text, c.from, c.to);
+            CHECK(why.find(c.needle) != std::string::npos);
+            CHECK(why.rfind("test.gltf: ", 0) == 0);
+        }
+    }
+    SECTION("sparse accessors: count and offsets are ints") {
+        const std::string sparse =
+            R"({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "sparse": )";
+        CHECK(refusal_of_edit(text, R"({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"})",
+                              sparse + R"({"count": 4294967297, "indices": {"bufferView": 1, "componentType": 5123},
+                                           "values": {"bufferView": 0}}})")
+                  .find("accessors[0].sparse.count: expected an integer from 0") != std::string::npos);
+        CHECK(refusal_of_edit(text, R"({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"})",
+                              sparse + R"({"count": 1, "indices": {"bufferView": 1, "byteOffset": 4294967296, "componentType": 5123},
+                                           "values": {"bufferView": 0}}})")
+                  .find("accessors[0].sparse.indices.byteOffset: expected an integer from 0") != std::string::npos);
+        CHECK(refusal_of_edit(text, R"({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"})",
+                              sparse + R"({"count": 1, "indices": {"bufferView": 1, "componentType": 5123},
+                                           "values": {"bufferView": 4294967296}}})")
+                  .find("accessors[0].sparse.values.bufferView: expected an integer from 0") != std::string::npos);
+    }
+    SECTION("what tinygltf keeps whole still loads") {
+        // The largest int, as an index, is out of range rather than wrapped.
+        CHECK(refusal_of_edit(text, R"("material": 0)", R"("material": 2147483647)")
+                  .find("material 2147483647 out of range") != std::string::npos);
+        // An extension's large number written with a fraction is a double, kept whole.
+        Gltf offset;
+        offset.texcoords = true;
+        offset.extra = R"("images": [{"uri": ")" + data_uri("image/png", png_file(1, 8, 0, {{128}})) +
+                       R"("}], "textures": [{"source": 0}],)";
+        offset.material = R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0,
+            "extensions": {"KHR_texture_transform": {"offset": [4294967296.0, -2147483648]}}}}})";
+        const Loaded l = load(offset);
+        CHECK(l.scene.materials[0].base_color_texture.row_u.z == 4294967296.0f);
+        CHECK(l.scene.materials[0].base_color_texture.row_v.z == -2147483648.0f);
+    }
+    SECTION("mcrt render exits 2 with one line") {
+        TempDir dir("mcrt-hostile");
+        std::string wrapped = text;
+        wrapped.replace(wrapped.find(R"("material": 0)"), 13, R"("material": 4294967297)");
+        write_text(dir / "wrapped.gltf", wrapped);
+        require_render_refused(dir / "wrapped.gltf",
+                               "wrapped.gltf: meshes[0].primitives[0].material: expected an integer "
+                               "from 0 to 2147483647, found 4294967297");
     }
 }
 

@@ -14,12 +14,18 @@
 #include <system_error>
 #include <vector>
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>  // environ
+
+#include <atomic>
+#include <sstream>
 
 #include "cl/build_child.h"
 #include "cl/cl_error.h"
 #include "cl/program.h"
 #include "common/atomic_file.h"
+#include "common/error.h"
 
 namespace mcrt {
 
@@ -116,17 +122,133 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// What lies at a cache file's name, without following it: the cache directory may be shared or
+// planted with links, FIFOs and directories named like entries (ROBUSTNESS.md, "The kernel cache").
+enum class CacheName { missing, regular, other };
+
+// Opens `path` for reading when it is a regular file: never through a symbolic link (O_NOFOLLOW)
+// and never blocking on a FIFO (O_NONBLOCK). -1 otherwise, with `kind` saying what is there.
+int open_cache_file(const std::string& path, CacheName& kind, std::string& what) {
+    kind = CacheName::missing;
+    const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) {
+        if (errno == ENOENT) return -1;
+        kind = CacheName::other;
+        what = errno == ELOOP ? "a symbolic link" : std::string(std::strerror(errno));
+        if (errno == EISDIR) what = "a directory";
+        return -1;
+    }
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        kind = CacheName::other;
+        what = S_ISDIR(st.st_mode) ? "a directory" : S_ISFIFO(st.st_mode) ? "a FIFO"
+             : S_ISSOCK(st.st_mode) ? "a socket" : "a device or special file";
+        ::close(fd);
+        return -1;
+    }
+    kind = CacheName::regular;
+    return fd;
+}
+
+// Removes what is not a regular file at a cache file's name, so that the cache heals: a link,
+// FIFO, socket or device node loses its name only (unlink(2) never touches what a link points
+// to), an empty directory is removed; "" on success, else why the name stays.
+std::string clear_cache_name(const std::string& path, const std::string& what) {
+    struct stat st {};
+    if (::lstat(path.c_str(), &st) != 0) return errno == ENOENT ? "" : std::strerror(errno);
+    if (S_ISREG(st.st_mode)) return "";
+    if (S_ISDIR(st.st_mode)) {
+        if (::rmdir(path.c_str()) == 0) return "";
+        return path + " is a directory that is not empty (" + std::strerror(errno) +
+               "); remove it to let the cache store this entry";
+    }
+    if (::unlink(path.c_str()) == 0) return "";
+    return path + " is " + what + " that cannot be removed: " + std::strerror(errno);
+}
+
+// The whole of a regular file at `path` (not through a link, not a FIFO); false with `why` set
+// when something else is there (and cleared away, see clear_cache_name) or it cannot be read.
+bool read_cache_file(const std::string& path, std::string& bytes, std::string& why) {
+    bytes.clear();
+    CacheName kind;
+    std::string what;
+    const int fd = open_cache_file(path, kind, what);
+    if (fd < 0) {
+        if (kind == CacheName::missing) return false;  // a plain miss
+        why = "not a regular file but " + what;
+        const std::string stays = clear_cache_name(path, what);
+        why += stays.empty() ? " (removed)" : "; " + stays;
+        return false;
+    }
+    char buffer[65536];
+    for (;;) {
+        const ssize_t n = ::read(fd, buffer, sizeof buffer);
+        if (n == 0) break;
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            why = "read error: " + std::string(std::strerror(errno));
+            ::close(fd);
+            return false;
+        }
+        bytes.append(buffer, size_t(n));
+    }
+    ::close(fd);
+    return true;
+}
+
+// Writes `bytes` to a cache file: a new temporary beside it (O_EXCL | O_NOFOLLOW: never an
+// existing file or a link's target), renamed onto the name. rename(2) replaces a link, FIFO or
+// device node at the name itself, never what a link points to; a directory there is cleared
+// first (clear_cache_name) or the store fails with the reason.
+void write_cache_file(const std::string& path, const std::string& bytes) {
+    static std::atomic<unsigned> counter{0};
+    sweep_stale_temporaries(path);  // those of writers killed before their rename
+    const fs::path target(path);
+    const std::string temporary = (target.parent_path() /
+                                   ("." + target.filename().string() + ".tmp-" +
+                                    std::to_string(::getpid()) + "-" + std::to_string(counter++)))
+                                      .string();
+    const int fd = ::open(temporary.c_str(),
+                          O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0) throw RuntimeError(temporary + ": cannot create: " + std::strerror(errno));
+    size_t written = 0;
+    while (written < bytes.size()) {
+        const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {
+            const int error = n < 0 ? errno : EIO;
+            ::close(fd);
+            ::unlink(temporary.c_str());
+            throw RuntimeError(temporary + ": cannot write: " + std::strerror(error));
+        }
+        written += size_t(n);
+    }
+    if (::close(fd) != 0) {
+        const int error = errno;
+        ::unlink(temporary.c_str());
+        throw RuntimeError(temporary + ": cannot write: " + std::strerror(error));
+    }
+    struct stat st {};
+    if (::lstat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+        const std::string stays = clear_cache_name(path, "a directory");
+        if (!stays.empty()) {
+            ::unlink(temporary.c_str());
+            throw RuntimeError(stays);
+        }
+    }
+    if (::rename(temporary.c_str(), path.c_str()) != 0) {
+        const int error = errno;
+        ::unlink(temporary.c_str());
+        throw RuntimeError(path + ": cannot rename the new entry into place: " + std::strerror(error));
+    }
+}
+
 // The payload of a valid entry for `key`, or an empty vector with `why` set.
 std::vector<unsigned char> read_entry(const std::string& path, const BinaryCacheKey& key,
                                       std::string& why) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return {};  // a plain miss, not a rejection
-    std::vector<unsigned char> file((std::istreambuf_iterator<char>(in)),
-                                    std::istreambuf_iterator<char>());
-    if (in.bad()) {
-        why = "read error";
-        return {};
-    }
+    std::string bytes;
+    if (!read_cache_file(path, bytes, why)) return {};  // a plain miss when `why` stays empty
+    const std::vector<unsigned char> file(bytes.begin(), bytes.end());
     if (file.size() < kHeaderBytes) {
         why = "truncated header";
         return {};
@@ -247,13 +369,9 @@ std::string store_binary_cache_entry(const std::string& path, const BinaryCacheK
         store_le64(header + 16, key.lo);
         store_le64(header + 24, binary.size());
         store_le64(header + 32, payload_hash(binary.data(), binary.size()));
-        write_atomically(path, [&](const std::string& temporary) {
-            std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-            out.write(reinterpret_cast<const char*>(header), sizeof header);
-            out.write(reinterpret_cast<const char*>(binary.data()), std::streamsize(binary.size()));
-            out.close();
-            if (!out) throw RuntimeError(temporary + ": cannot write");
-        });
+        std::string bytes(reinterpret_cast<const char*>(header), sizeof header);
+        bytes.append(reinterpret_cast<const char*>(binary.data()), binary.size());
+        write_cache_file(path, bytes);
         return {};
     } catch (const std::exception& e) {
         return e.what();
@@ -264,19 +382,15 @@ std::string store_binary_cache_entry(const std::string& path, const BinaryCacheK
 // throws (an unreadable or unwritable counter counts as none: the binary is stored later).
 static int count_miss(const std::string& counter) {
     int misses = 0;
-    {
-        std::ifstream in(counter);
-        if (!(in >> misses) || misses < 0) misses = 0;
+    std::string text, why;
+    if (read_cache_file(counter, text, why)) {
+        std::istringstream in(text);
+        if (!(in >> misses) || misses < 0 || misses > 1000000) misses = 0;
     }
     try {
         std::error_code ec;
         fs::create_directories(fs::path(counter).parent_path(), ec);
-        write_atomically(counter, [&](const std::string& temporary) {
-            std::ofstream out(temporary, std::ios::trunc);
-            out << misses + 1 << "\n";
-            out.close();
-            if (!out) throw RuntimeError(temporary + ": cannot write");
-        });
+        write_cache_file(counter, std::to_string(misses + 1) + "\n");
     } catch (const std::exception&) {
     }
     return misses;
@@ -336,10 +450,7 @@ cl::Program build_program_cached(const cl::Context& context, const cl::Device& d
         return program;
     }
     r.store_error = store_binary_cache_entry(r.path, key, program_binary(program, device));
-    if (store_after_misses > 1 && r.store_error.empty()) {
-        std::error_code ignored;
-        fs::remove(counter, ignored);
-    }
+    if (store_after_misses > 1 && r.store_error.empty()) ::unlink(counter.c_str());  // the name only
     r.seconds = seconds_since(t0);
     return program;
 }

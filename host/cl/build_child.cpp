@@ -5,10 +5,12 @@
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/prctl.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -45,14 +47,48 @@ bool write_text(const fs::path& path, const std::string& text) {
     return bool(out);
 }
 
-// A private directory for one build's files, removed with the object.
+const std::string kBuildDirectoryPrefix = "mcrt-build-";
+
+// The PID in a build directory's name `mcrt-build-PID-XXXXXX`, or 0 when `name` is not one.
+pid_t build_directory_owner(const std::string& name) {
+    if (name.compare(0, kBuildDirectoryPrefix.size(), kBuildDirectoryPrefix) != 0) return 0;
+    const std::string rest = name.substr(kBuildDirectoryPrefix.size());
+    const size_t dash = rest.find('-');
+    if (dash == 0 || dash == std::string::npos || rest.size() - dash - 1 != 6) return 0;
+    if (rest.find_first_not_of("0123456789") != dash) return 0;
+    if (dash > 9) return 0;
+    return pid_t(std::stol(rest.substr(0, dash)));
+}
+
+// Removes the build directories of processes that ended without removing their own (a render
+// killed by SIGKILL while a child built its kernels): only directories of this user, named as
+// BuildDirectory names them, whose PID names no process.
+void sweep_stale_build_directories(const fs::path& parent) {
+    std::error_code ec;
+    for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
+        const pid_t owner = build_directory_owner(it->path().filename().string());
+        if (owner <= 0 || owner == ::getpid()) continue;
+        struct stat st {};
+        if (::lstat(it->path().c_str(), &st) != 0 || !S_ISDIR(st.st_mode) || st.st_uid != ::getuid())
+            continue;
+        if (::kill(owner, 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to ask
+        std::error_code ignored;
+        fs::remove_all(it->path(), ignored);
+    }
+}
+
+// A private directory for one build's files (mkdtemp(3): mode 0700), removed with the object;
+// its name holds this process's PID, so that a later build removes it if this process is killed.
 struct BuildDirectory {
     fs::path path;
     BuildDirectory() {
-        std::string pattern = (fs::temp_directory_path() / "mcrt-build-XXXXXX").string();
+        const fs::path parent = fs::temp_directory_path();
+        sweep_stale_build_directories(parent);
+        std::string pattern =
+            (parent / (kBuildDirectoryPrefix + std::to_string(::getpid()) + "-XXXXXX")).string();
         if (::mkdtemp(pattern.data()) == nullptr)
             throw RuntimeError("cannot create a directory for a kernel build in " +
-                               fs::temp_directory_path().string() + ": " + std::strerror(errno));
+                               parent.string() + ": " + std::strerror(errno));
         path = pattern;
     }
     ~BuildDirectory() {
@@ -60,6 +96,20 @@ struct BuildDirectory {
         fs::remove_all(path, ignored);
     }
 };
+
+// Writes a new file for the parent to read; never replaces or follows what is at the name.
+bool write_new_file(const fs::path& path, const std::string& text) {
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);
+    if (fd < 0) return false;
+    size_t written = 0;
+    while (written < text.size()) {
+        const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) break;
+        written += size_t(n);
+    }
+    return ::close(fd) == 0 && written == text.size();
+}
 
 // The last non-empty line of a compiler's dump, which often names what failed.
 std::string last_line(const std::string& text) {
@@ -174,6 +224,26 @@ int run_build_program_child(const std::string& dir_text, int device_index) {
     // Ends with mcrt: an orphaned build is of use to no one.
     ::prctl(PR_SET_PDEATHSIG, SIGKILL);
     const fs::path dir = dir_text;
+    // Run by hand, it must not replace a user's files: it works only in a build directory as
+    // mcrt makes one (its name, this user's, mode 0700, the source and options in it, no result).
+    {
+        struct stat st {};
+        std::string refusal;
+        if (::lstat(dir.c_str(), &st) != 0)
+            refusal = std::string(std::strerror(errno));
+        else if (!S_ISDIR(st.st_mode) || build_directory_owner(dir.filename().string()) == 0 ||
+                 st.st_uid != ::getuid() || (st.st_mode & 077) != 0 ||
+                 !fs::is_regular_file(dir / "source.cl") || !fs::is_regular_file(dir / "options"))
+            refusal = "not a kernel build directory of mcrt's (mcrt makes them itself)";
+        else if (fs::symlink_status(dir / "binary").type() != fs::file_type::not_found ||
+                 fs::symlink_status(dir / "error").type() != fs::file_type::not_found)
+            refusal = "holds a result already; not replaced";
+        if (!refusal.empty()) {
+            std::fprintf(stderr, "mcrt: error: build-program: %s: %s\n", dir_text.c_str(),
+                         refusal.c_str());
+            return 2;
+        }
+    }
     try {
         std::vector<DeviceInfo> devices = enumerate_devices([](const std::string&) {});
         if (device_index < 0 || size_t(device_index) >= devices.size())
@@ -188,15 +258,15 @@ int run_build_program_child(const std::string& dir_text, int device_index) {
         std::vector<unsigned char> binary = program_binary(program, device.info.device);
         if (binary.empty()) throw std::runtime_error("the driver returned no binary");
         const fs::path partial = dir / "binary.partial";
-        if (!write_text(partial, std::string(binary.begin(), binary.end())))
+        if (!write_new_file(partial, std::string(binary.begin(), binary.end())))
             throw std::runtime_error("cannot write " + partial.string());
         fs::rename(partial, dir / "binary");
         return 0;
     } catch (const RuntimeError& e) {  // the build failed: its log for the parent
-        write_text(dir / "error", e.what());
+        write_new_file(dir / "error", e.what());
         return 3;
     } catch (const std::exception& e) {
-        write_text(dir / "error", e.what());
+        write_new_file(dir / "error", e.what());
         return 1;
     }
 }

@@ -50,6 +50,7 @@ struct InterruptGuard {
     InterruptGuard() {
         g_interrupted = 0;
         set_build_stop_flag(&g_interrupted);  // a kernel build in a child process stops too
+        set_stop_flag(&g_interrupted);         // so does the output commit's wait for a lock
         struct sigaction action {};
         action.sa_handler = on_interrupt;
         action.sa_flags = SA_RESETHAND;

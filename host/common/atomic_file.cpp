@@ -21,6 +21,7 @@
 
 #include "common/error.h"
 #include "common/output_paths.h"
+#include "common/stop_signals.h"
 #include "common/test_hooks.h"
 
 namespace mcrt {
@@ -89,23 +90,46 @@ bool is_zombie(pid_t pid) {
     return paren != std::string::npos && paren + 2 < stat.size() && stat[paren + 2] == 'Z';
 }
 
-// Holds an exclusive flock(2) on each directory given, taken in sorted order so that two sets
-// over the same directories cannot deadlock; released by close(2).
+// Holds an exclusive flock(2) on each distinct directory given. A directory is distinct by its
+// device and inode, not its name: flock(2) locks belong to an open file description, so one
+// directory named two ways (`o.exr` beside `$PWD/s.json`, `out/./a.png`, `/proc/self/fd/1`'s
+// file) and opened twice would wait on itself forever. The locks are taken in (device, inode)
+// order, so two sets over the same directories cannot deadlock; released by close(2). A stop
+// signal while another process holds a lock ends the wait with an error (nothing is written).
 class DirectoryLocks {
   public:
-    explicit DirectoryLocks(std::vector<std::string> directories) {
-        std::sort(directories.begin(), directories.end());
-        directories.erase(std::unique(directories.begin(), directories.end()), directories.end());
+    explicit DirectoryLocks(const std::vector<std::string>& directories) {
+        struct Opened {
+            dev_t device;
+            ino_t inode;
+            int fd;
+            std::string name;
+        };
+        std::vector<Opened> opened;
         for (const std::string& dir : directories) {
             const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
             if (fd < 0) continue;  // unlockable: the renames are still each atomic
-            if (::flock(fd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK) {
-                test_pause("commit-wait");  // another set holds it: the tests see this one wait
-                while (::flock(fd, LOCK_EX) != 0 && errno == EINTR) {
-                }
+            struct stat st {};
+            if (::fstat(fd, &st) != 0) {
+                ::close(fd);
+                continue;
             }
-            fds_.push_back(fd);
+            opened.push_back({st.st_dev, st.st_ino, fd, dir});
         }
+        std::sort(opened.begin(), opened.end(), [](const Opened& a, const Opened& b) {
+            return a.device != b.device ? a.device < b.device : a.inode < b.inode;
+        });
+        std::vector<const Opened*> distinct;
+        for (size_t i = 0; i < opened.size(); ++i) {
+            if (i > 0 && opened[i].device == opened[i - 1].device &&
+                opened[i].inode == opened[i - 1].inode) {
+                ::close(opened[i].fd);  // the same directory under another name
+                continue;
+            }
+            fds_.push_back(opened[i].fd);
+            distinct.push_back(&opened[i]);
+        }
+        for (const Opened* directory : distinct) lock(directory->fd, directory->name);
     }
     ~DirectoryLocks() {
         for (int fd : fds_) ::close(fd);
@@ -114,6 +138,22 @@ class DirectoryLocks {
     DirectoryLocks& operator=(const DirectoryLocks&) = delete;
 
   private:
+    void lock(int fd, const std::string& name) {
+        if (::flock(fd, LOCK_EX | LOCK_NB) == 0 || errno != EWOULDBLOCK) return;
+        test_pause("commit-wait");  // another set holds it: the tests see this one wait
+        // Polled rather than blocking, so that a stop signal at any instant ends the wait.
+        while (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+            if (errno != EWOULDBLOCK && errno != EINTR) return;  // unlockable: renames stay atomic
+            if (stop_requested()) {
+                for (int open_fd : fds_) ::close(open_fd);
+                fds_.clear();
+                throw RuntimeError("stopped while another process was writing its outputs in " +
+                                   name + "; no output written");
+            }
+            ::usleep(10000);
+        }
+    }
+
     std::vector<int> fds_;
 };
 

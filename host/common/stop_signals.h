@@ -10,6 +10,12 @@ namespace mcrt {
 // ssh session): each stops a render, which writes the samples done so far.
 inline constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
 
+// The flag a stop signal raises while a render runs (the render's interrupt guard sets it), or
+// nullptr: work that blocks outside the render loop (the output commit's wait for another
+// process's lock) reads it through stop_requested().
+void set_stop_flag(const volatile std::sig_atomic_t* flag);
+bool stop_requested();
+
 // After every output is complete a stop signal has nothing left to save: the stop signals are
 // ignored for the rest of the process, so it still exits 0.
 void outputs_complete();

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstring>
+#include <mutex>
+#include <system_error>
+#include <thread>
 
 namespace mcrt {
 
@@ -21,38 +25,101 @@ void Accumulator::submit(BatchResult result) {
     }
 }
 
+namespace {
+
+// 2^e exactly, as std::ldexp(1.0, e) gives it for the exponents the kernels write (|e| < 1000),
+// without a call into libm per pixel and channel.
+double power_of_two(int e) {
+    e = std::clamp(e, -1022, 1023);
+    uint64_t bits = uint64_t(1023 + e) << 52;
+    double value;
+    std::memcpy(&value, &bits, sizeof value);
+    return value;
+}
+
+// Runs body(begin, end) over [0, count) in contiguous parts on up to all cores: a GPU delivers a
+// batch faster than one host thread merges it (docs/BENCHMARKS.md "On a GPU"). Each pixel's
+// arithmetic is the same on any part, so the image does not depend on the number of threads.
+template <class Body>
+void for_pixel_ranges(size_t count, const Body& body) {
+    constexpr size_t kMinimumPart = 32768;  // below this a thread costs more than it saves
+    static const size_t cores = std::max(1u, std::min(16u, std::thread::hardware_concurrency()));
+    const size_t parts = std::min(cores, std::max<size_t>(1, count / kMinimumPart));
+    if (parts <= 1) {
+        body(0, count);
+        return;
+    }
+    std::vector<std::thread> threads;
+    threads.reserve(parts - 1);
+    const size_t step = (count + parts - 1) / parts;
+    try {
+        for (size_t begin = step; begin < count; begin += step)
+            threads.emplace_back([&body, begin, step, count] { body(begin, std::min(count, begin + step)); });
+    } catch (const std::system_error&) {
+        // No thread to be had (a process limit): the parts not started run here.
+        for (size_t begin = step * (threads.size() + 1); begin < count; begin += step)
+            body(begin, std::min(count, begin + step));
+    }
+    body(0, std::min(count, step));
+    for (std::thread& t : threads) t.join();
+}
+
+}  // namespace
+
 void Accumulator::apply(const BatchResult& r) {
     const WorkItem& item = r.item;
     const uint32_t chunks = item.chunk_count(), K = replicates_;
+    const uint32_t pixel_count = item.pixel_count();
     for (uint32_t c = 0; c < chunks; ++c) {
-        for (uint32_t p = 0; p < item.pixel_count(); ++p) {
-            for (uint32_t k = 0; k < K; ++k) {
-                const gpu::ChunkSums& s = r.sums[(size_t(p) * chunks + c) * K + k];
-                const double n = s.sum_sq.w;
-                const size_t at = 3 * (size_t(item.pixel_begin + p) * K + k);
-                const float shift[3] = {s.shift.x, s.shift.y, s.shift.z};
-                const float sum[3] = {s.sum.x, s.sum.y, s.sum.z};
-                const float sum_sq[3] = {s.sum_sq.x, s.sum_sq.y, s.sum_sq.z};
-                const float exponent[3] = {s.exponent.x, s.exponent.y, s.exponent.z};
-                // Within a row each pixel receives one run per replicate: the row holds it.
-                for (int ch = 0; ch < 3; ++ch) {
-                    const double scale = std::ldexp(1.0, int(exponent[ch]));
-                    row_mean_[at + ch] = double(shift[ch]) + double(sum[ch]) * scale / n;
-                    if (K == 1) {
-                        const double d = double(sum[ch]);
-                        row_m2_[at + ch] = std::max(0.0, double(sum_sq[ch]) - d * d / n) * scale * scale;
+        // The counters are integers: each part's sums added afterwards are exact in any order.
+        struct Counts {
+            uint64_t nan = 0, rays = 0, vertices = 0, roulette = 0;
+            double n = 0;
+        };
+        std::mutex counts_mutex;
+        Counts total;
+        for_pixel_ranges(pixel_count, [&](size_t begin, size_t end) {
+            Counts part;
+            for (size_t p = begin; p < end; ++p) {
+                for (uint32_t k = 0; k < K; ++k) {
+                    const gpu::ChunkSums& s = r.sums[(p * chunks + c) * K + k];
+                    const double n = s.sum_sq.w;
+                    const size_t at = 3 * ((item.pixel_begin + p) * K + k);
+                    const float shift[3] = {s.shift.x, s.shift.y, s.shift.z};
+                    const float sum[3] = {s.sum.x, s.sum.y, s.sum.z};
+                    const float sum_sq[3] = {s.sum_sq.x, s.sum_sq.y, s.sum_sq.z};
+                    const float exponent[3] = {s.exponent.x, s.exponent.y, s.exponent.z};
+                    // Within a row each pixel receives one run per replicate: the row holds it.
+                    for (int ch = 0; ch < 3; ++ch) {
+                        const double scale = power_of_two(int(exponent[ch]));
+                        row_mean_[at + ch] = double(shift[ch]) + double(sum[ch]) * scale / n;
+                        if (K == 1) {
+                            const double d = double(sum[ch]);
+                            row_m2_[at + ch] = std::max(0.0, double(sum_sq[ch]) - d * d / n) * scale * scale;
+                        }
                     }
+                    part.n = n;  // the same for every pixel of a row: its chunk, over K
+                    part.nan += uint64_t(s.shift.w);
+                    part.rays += uint64_t(s.sum.w);
+                    // Path vertices + 2^15 × roulette ends (kernels/shared_types.h).
+                    const uint64_t path = uint64_t(s.exponent.w);
+                    part.vertices += path & 0x7fff;
+                    part.roulette += path >> 15;
                 }
-                row_n_ = n;  // the same for every pixel of a row: its chunk, over K
-                row_nan_ += uint64_t(s.shift.w);
-                row_rays_ += uint64_t(s.sum.w);
-                // Path vertices + 2^15 × roulette ends (kernels/shared_types.h).
-                const uint64_t path = uint64_t(s.exponent.w);
-                row_vertices_ += path & 0x7fff;
-                row_roulette_ += path >> 15;
             }
-        }
-        row_pixels_ += item.pixel_count();
+            std::lock_guard<std::mutex> lock(counts_mutex);
+            total.nan += part.nan;
+            total.rays += part.rays;
+            total.vertices += part.vertices;
+            total.roulette += part.roulette;
+            if (end > begin) total.n = part.n;
+        });
+        if (pixel_count > 0) row_n_ = total.n;
+        row_nan_ += total.nan;
+        row_rays_ += total.rays;
+        row_vertices_ += total.vertices;
+        row_roulette_ += total.roulette;
+        row_pixels_ += pixel_count;
         if (row_pixels_ == pixels_) commit_row();
     }
 }
@@ -60,11 +127,13 @@ void Accumulator::apply(const BatchResult& r) {
 void Accumulator::commit_row() {
     // Chan, Golub & LeVeque 1983: (n_a, mean_a, M2_a) ⊕ (n_b, mean_b, M2_b).
     const double n_a = n_, n_b = row_n_, n = n_a + n_b;
-    for (size_t k = 0; k < mean_.size(); ++k) {
-        const double delta = row_mean_[k] - mean_[k];
-        mean_[k] += delta * (n_b / n);
-        if (!m2_.empty()) m2_[k] += row_m2_[k] + delta * delta * (n_a * n_b / n);
-    }
+    for_pixel_ranges(mean_.size(), [&](size_t begin, size_t end) {
+        for (size_t k = begin; k < end; ++k) {
+            const double delta = row_mean_[k] - mean_[k];
+            mean_[k] += delta * (n_b / n);
+            if (!m2_.empty()) m2_[k] += row_m2_[k] + delta * delta * (n_a * n_b / n);
+        }
+    });
     n_ = n;
     nan_samples_ += row_nan_;
     rays_ += row_rays_;

@@ -203,12 +203,20 @@ void GeometryImporter::add_primitive(const tinygltf::Primitive& primitive,
     const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
     const std::array<size_t, 3> corner_order =
         mirrored ? std::array<size_t, 3>{0, 2, 1} : std::array<size_t, 3>{0, 1, 2};
-    const uint32_t material = materials_.slot(primitive.material, element);
+    // The material as this primitive sees it: textures on a TEXCOORD_n it lacks left out.
+    uint32_t texcoord_sets = 0;
+    for (uint32_t n = 0; n < 2; ++n)
+        texcoord_sets |= uint32_t(primitive.attributes.count("TEXCOORD_" + std::to_string(n))) << n;
+    std::string left_out;
+    const uint32_t material = materials_.slot_for_texcoords(
+        materials_.slot(primitive.material, element), texcoord_sets, left_out);
+    if (!left_out.empty()) note_left_out_textures(primitive.material, element, left_out);
     const Material& surface = scene_.materials[material];
     const double Le_luminance = luminance(surface.emission);
 
     // The corners' texture attributes, once any primitive's material reads them.
-    const AttributeNeeds needs = attribute_needs(model_, primitive.material);
+    AttributeNeeds needs = attribute_needs(model_, primitive.material);
+    if (needs.normal_texcoord >= 0 && !surface.normal_texture.used()) needs.normal_texcoord = -1;
     if (needs.texcoords && triangles > 0 && !corner_attributes_) {
         start_corner_attributes(scene_);
         corner_attributes_ = true;
@@ -242,7 +250,28 @@ void GeometryImporter::add_primitive(const tinygltf::Primitive& primitive,
     }
 }
 
+void GeometryImporter::note_left_out_textures(int material_index, const std::string& element,
+                                              const std::string& left_out) {
+    // Instances of one primitive count once.
+    if (!left_out_primitives_.insert(element).second) return;
+    if (left_out_primitives_.size() > 1) return;
+    std::string material = element_name("material", size_t(material_index));
+    const std::string& name = model_.materials[size_t(material_index)].name;
+    if (!name.empty()) material += " (\"" + name + "\")";
+    left_out_first_ = element + ": lacks the texture coordinates that " + material + " reads for " +
+                      left_out +
+                      "; ignored there, the factors alone apply (glTF 2.0 \"Texture Data\": a "
+                      "primitive MUST have them)";
+}
+
 void GeometryImporter::finish() {
+    if (!left_out_primitives_.empty()) {
+        const size_t others = left_out_primitives_.size() - 1;
+        diag_.warn_once(
+            "texcoord-missing",
+            left_out_first_ +
+                (others ? "; the same on " + std::to_string(others) + " more primitive(s)" : ""));
+    }
     // Light selection divides by shares of the total: it must be a float too.
     if (!(total_power_ <= 0.5 * std::numeric_limits<float>::max())) {
         diag_.fail("the emitters' summed power " + format_number(total_power_) +

@@ -4,6 +4,7 @@
 #include <tiny_gltf.h>
 
 #include <glm/glm.hpp>
+#include <set>
 #include <string>
 
 #include "scene/gltf_diagnostics.h"
@@ -33,6 +34,11 @@ class GeometryImporter {
     void finish();
 
   private:
+    // Primitive `element` lacks the TEXCOORD_n of its material's textures `left_out`: noted here,
+    // warned about once in finish().
+    void note_left_out_textures(int material_index, const std::string& element,
+                                const std::string& left_out);
+
     const tinygltf::Model& model_;
     Diagnostics& diag_;
     MaterialTable& materials_;
@@ -41,6 +47,8 @@ class GeometryImporter {
     double max_coordinate_ = 0.0;  // largest |component| of a world position
     // A textured primitive came: from then on every corner has attributes.
     bool corner_attributes_ = false;
+    std::set<std::string> left_out_primitives_;  // primitives with textures left out
+    std::string left_out_first_;                 // the first, as the warning names it
 };
 
 }  // namespace mcrt::gltf

@@ -6,13 +6,16 @@
 #include <stb/stb_image.h>
 
 #include <algorithm>
-#include <atomic>
 #include <climits>
+#include <condition_variable>
 #include <cstring>
 #include <exception>
+#include <mutex>
 #include <system_error>
 #include <thread>
 
+#include "image/jpeg_structure.h"
+#include "image/png_structure.h"
 #include "scene/gltf_limits.h"
 
 namespace mcrt::gltf {
@@ -30,11 +33,10 @@ struct Encoded {
     size_t size = 0;
     Format format = Format::Png;
     unsigned width = 0, height = 0;
+    PngLayout png;              // a PNG's chunks
+    JpegFrame jpeg;             // a JPEG's frame header
+    uint64_t decode_bytes = 0;  // what decoding it holds at most (decode_bytes())
 };
-
-uint32_t big_endian_32(const unsigned char* p) {
-    return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | uint32_t(p[3]);
-}
 
 bool starts_with(const unsigned char* data, size_t size, const char* prefix, size_t length) {
     return size >= length && std::memcmp(data, prefix, length) == 0;
@@ -119,58 +121,80 @@ void check_size(const Encoded& encoded, const Diagnostics& diag) {
 // no compressed byte inflates to more than 1032.
 constexpr unsigned long long kMaxInflateRatio = 1032;
 
-// PNG's chunk layout (ISO/IEC 15948 sec. 5.3), walked before stb_image reads the file: IHDR
-// first (its size read and checked here, before anything else: stb_image refuses to report a
-// size it thinks too large), IEND reached within the bytes, no critical chunk stb_image does not
-// know, and IDAT data that can inflate to the samples IHDR declares: stb_image allocates the whole
-// image before it finds too few, so 100 bytes declaring 16384² would cost it a gigabyte. A file
-// cut short is named here; stb_image would read on past its end as zeros.
-void walk_png_chunks(Encoded& encoded, const Diagnostics& diag) {
-    const unsigned char* d = encoded.data;
-    const size_t n = encoded.size;
-    size_t at = 8;
-    unsigned long long sample_bits = 0, idat_bytes = 0;
-    for (bool first = true;; first = false) {
-        if (n - at < 12) {
-            diag.fail(encoded.element, "the PNG is truncated: " + std::to_string(n) +
-                                           " bytes end before its IEND chunk");
-        }
-        const uint32_t length = big_endian_32(d + at);
-        const std::string type(reinterpret_cast<const char*>(d + at + 4), 4);
-        if (first) {
-            if (type != "IHDR" || length != 13 || n - at < 12 + 13) {
-                diag.fail(encoded.element, "the PNG does not start with a whole IHDR chunk");
-            }
-            encoded.width = big_endian_32(d + at + 8);
-            encoded.height = big_endian_32(d + at + 12);
-            check_size(encoded, diag);
-            const unsigned depth = d[at + 16], colour_type = d[at + 17];
-            const unsigned samples[7] = {1, 0, 3, 1, 2, 0, 4};  // per texel, by colour type
-            sample_bits = (unsigned long long)encoded.width * encoded.height * depth *
-                          (colour_type < 7 ? samples[colour_type] : 0);
-        }
-        if (length > n - at - 12) {
-            diag.fail(encoded.element, "the PNG is truncated: its chunk at byte " +
-                                           std::to_string(at) + " holds " + std::to_string(length) +
-                                           " bytes, " + std::to_string(n - at - 12) + " remain");
-        }
-        if (type == "IDAT") idat_bytes += length;
-        if (type == "IEND") {
-            if (idat_bytes * kMaxInflateRatio < sample_bits / 8) {
-                diag.fail(encoded.element, "the PNG's " + std::to_string(idat_bytes) +
-                                               " bytes of IDAT data cannot hold the " +
-                                               std::to_string(encoded.width) + " × " +
-                                               std::to_string(encoded.height) +
-                                               " texels it declares");
-            }
-            return;
-        }
-        const bool critical = (d[at + 4] & 0x20) == 0;  // ancillary chunks: gAMA, iCCP, ... skipped
-        if (critical && type != "IHDR" && type != "PLTE" && type != "IDAT" && type != "CgBI") {
-            diag.fail(encoded.element, "the PNG holds a critical chunk of unknown type");
-        }
-        at += 12 + length;
+// PNG's chunk layout (png_structure.h), read before stb_image sees the file: IHDR first (its
+// size checked against the limits before anything else: stb_image refuses to report a size it
+// thinks too large), then every chunk and its CRC, and IDAT data that can inflate to the samples
+// IHDR declares at deflate's largest ratio: stb_image allocates the whole image before it finds
+// too few, so 100 bytes declaring 16384² would cost it a gigabyte. A file cut short is named
+// here; stb_image would read on past its end as zeros. The IDAT data itself is inflated and
+// counted when the image is decoded (check_png_samples).
+void read_png_header(Encoded& encoded, const Diagnostics& diag) {
+    std::string why = read_png_layout(encoded.data, encoded.size, encoded.png, true);
+    if (!why.empty()) diag.fail(encoded.element, why);
+    encoded.width = encoded.png.width;
+    encoded.height = encoded.png.height;
+    check_size(encoded, diag);
+    why = read_png_layout(encoded.data, encoded.size, encoded.png);
+    if (!why.empty()) diag.fail(encoded.element, why);
+    if (encoded.png.idat_bytes * kMaxInflateRatio < png_filtered_bytes(encoded.png)) {
+        diag.fail(encoded.element, "the PNG's " + std::to_string(encoded.png.idat_bytes) +
+                                       " bytes of IDAT data cannot hold the " +
+                                       std::to_string(encoded.width) + " × " +
+                                       std::to_string(encoded.height) + " texels it declares");
     }
+    // stb_image allocates each of its buffers only up to INT_MAX bytes (stbi__mad3sizes_valid),
+    // the inflated scanlines' size in an int: 16-bit RGB(A) at 16384² fails it, after a full
+    // inflate, under another decoder's error ("no SOI"). Its image has 4 channels for colour and
+    // palette, up to 2 for grey.
+    const uint64_t image_bytes =
+        uint64_t(encoded.width) * encoded.height *
+        (encoded.png.colour_type == 0 || encoded.png.colour_type == 4 ? 2 : 4) *
+        (encoded.png.depth == 16 ? 2 : 1);
+    const uint64_t largest = std::max(image_bytes, png_filtered_bytes(encoded.png));
+    if (largest > uint64_t(INT_MAX)) {
+        diag.fail(encoded.element, std::to_string(encoded.width) + " × " +
+                                       std::to_string(encoded.height) + " texels of " +
+                                       std::to_string(encoded.png.depth) +
+                                       "-bit samples need a buffer of " + std::to_string(largest) +
+                                       " bytes, more than the 2 GiB stb_image (mcrt's decoder) "
+                                       "allocates at once");
+    }
+}
+
+// The JPEG's frame header (jpeg_structure.h): a coding stb_image reads, a size within the limits
+// and one the file's bytes can hold. stb_image allocates the declared image whole and decodes a
+// scan that runs out as zeros.
+void read_jpeg_header(Encoded& encoded, const Diagnostics& diag) {
+    JpegFrame& frame = encoded.jpeg;
+    const std::string why = read_jpeg_frame(encoded.data, encoded.size, frame);
+    if (!why.empty()) diag.fail(encoded.element, why);
+    encoded.width = frame.width;
+    encoded.height = frame.height;
+    check_size(encoded, diag);
+    const uint64_t least = jpeg_min_bytes(frame);
+    if (encoded.size < least) {
+        diag.fail(encoded.element,
+                  "the JPEG's " + std::to_string(encoded.size) + " bytes cannot hold the " +
+                      std::to_string(frame.width) + " × " + std::to_string(frame.height) +
+                      " texels it declares: its " + std::to_string(frame.blocks) +
+                      " blocks of 8 × 8 need at least " + std::to_string(least) + " (a bit each)");
+    }
+}
+
+// What decoding `encoded` holds at most, every buffer of every stage counted as if all were held
+// at once (an upper bound), from the stages of stb_image 2.27 and mcrt's copy of the texels:
+// PNG: the IDAT data gathered (up to twice its size as it grows), the inflated scanlines, the
+// image at its bit depth and up to 4 channels, the same as 8-bit RGBA; JPEG: the component planes
+// padded to whole MCUs, a byte each and two bytes of coefficient more when progressive, and the
+// 8-bit RGBA image. Both: mcrt's copy (TextureImage::rgba).
+uint64_t decode_bytes(const Encoded& encoded) {
+    const uint64_t rgba = uint64_t(encoded.width) * encoded.height * 4;
+    if (encoded.format == Format::Png) {
+        const PngLayout& png = encoded.png;
+        return 2 * png.idat_bytes + png_filtered_bytes(png) + rgba * (png.depth == 16 ? 2 : 1) +
+               rgba + rgba;
+    }
+    return encoded.jpeg.padded_samples * (encoded.jpeg.progressive() ? 3 : 1) + rgba + rgba;
 }
 
 // The header of `encoded`: its size (within the limits) and stb_image's acceptance of it.
@@ -178,7 +202,11 @@ void read_header(Encoded& encoded, const Diagnostics& diag) {
     if (encoded.size > size_t(INT_MAX)) {
         diag.fail(encoded.element, "the encoded image is larger than 2 GiB");
     }
-    if (encoded.format == Format::Png) walk_png_chunks(encoded, diag);
+    if (encoded.format == Format::Png) {
+        read_png_header(encoded, diag);
+    } else {
+        read_jpeg_header(encoded, diag);
+    }
     int width = 0, height = 0, components = 0;
     if (!stbi_info_from_memory(encoded.data, int(encoded.size), &width, &height, &components)) {
         const char* reason = stbi_failure_reason();
@@ -186,17 +214,20 @@ void read_header(Encoded& encoded, const Diagnostics& diag) {
                                        " header is corrupt" +
                                        (reason && *reason ? std::string(": ") + reason : ""));
     }
-    if (encoded.format == Format::Jpeg) {
-        encoded.width = unsigned(width);
-        encoded.height = unsigned(height);
-        check_size(encoded, diag);
+    if (unsigned(width) != encoded.width || unsigned(height) != encoded.height) {
+        diag.fail(encoded.element, "stb_image reads another size than its header's");
     }
+    encoded.decode_bytes = decode_bytes(encoded);
 }
 
 // One image decoded to RGBA: grey, grey + alpha, RGB and palettes widened, 16-bit samples
 // reduced to their high byte, alpha 255 where the file has none; row 0 the top row, as stored.
 TextureImage decode(const tinygltf::Image& image, size_t index, const Encoded& encoded,
                     const Diagnostics& diag) {
+    if (encoded.format == Format::Png) {
+        const std::string why = check_png_samples(encoded.data, encoded.png);
+        if (!why.empty()) diag.fail(encoded.element, why);
+    }
     int width = 0, height = 0, components = 0;
     stbi_uc* texels =
         stbi_load_from_memory(encoded.data, int(encoded.size), &width, &height, &components, 4);
@@ -248,19 +279,35 @@ std::vector<TextureImage> decode_images(const tinygltf::Model& model,
         }
     }
 
-    // Then the texels, images handed out one at a time to the threads; each failure is kept
-    // with its image, and the first in `sources` order is the one reported.
+    // Then the texels, images handed out one at a time, in order, to the threads, each starting
+    // once the decoders' estimates in flight leave room for its own (kMaxDecodingBytes; alone
+    // when it is larger); each failure is kept with its image, and the first in `sources` order
+    // is the one reported.
     std::vector<TextureImage> images(sources.size());
     std::vector<std::exception_ptr> failures(sources.size());
-    std::atomic<size_t> next{0};
+    std::mutex mutex;
+    std::condition_variable room;
+    size_t next = 0;
+    uint64_t in_flight = 0;
     auto work = [&] {
-        for (size_t k; (k = next.fetch_add(1)) < sources.size();) {
+        while (true) {
+            std::unique_lock<std::mutex> lock(mutex);
+            if (next == sources.size()) return;
+            const size_t k = next++;
+            const uint64_t need = encoded[k].decode_bytes;
+            room.wait(lock,
+                      [&] { return in_flight == 0 || in_flight + need <= kMaxDecodingBytes; });
+            in_flight += need;
+            lock.unlock();
             try {
                 const size_t index = size_t(sources[k]);
                 images[k] = decode(model.images[index], index, encoded[k], diag);
             } catch (...) {
                 failures[k] = std::current_exception();
             }
+            lock.lock();
+            in_flight -= need;
+            room.notify_all();
         }
     };
     if (threads == 0) threads = std::min(8u, std::max(1u, std::thread::hardware_concurrency()));

@@ -20,6 +20,10 @@ constexpr double kWarnCoordinate = 1e10;
 // 2048), and 2^30 texels (4 GiB) over all the images a scene's materials use.
 constexpr unsigned kMaxImageSide = 16384;
 constexpr unsigned long long kMaxImageTexels = 1ull << 30;
+// What the decoders hold while images decode, estimated from each header (gltf_images.cpp
+// decode_bytes): images are decoded at once on several threads only while their estimates sum to
+// at most this; an image whose estimate is larger is decoded alone.
+constexpr unsigned long long kMaxDecodingBytes = 4ull << 30;
 // Encoded image files, whose size nothing declares, checked before they are read (tinygltf reads
 // every image file, used or not): each at most 1 GiB, what the largest image allowed above holds
 // as 8-bit RGBA, and 4 GiB over all of a scene's image files.

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 
 #include "common/value_limits.h"
@@ -129,6 +130,17 @@ void read_texture_slots(const tinygltf::Material& source, const std::string& ele
     }
 }
 
+// The texture slots a primitive's texture coordinates feed, named as in glTF.
+struct TextureSlot {
+    const char* name;
+    TextureRef Material::*ref;
+};
+const TextureSlot kTextureSlots[] = {
+    {"baseColorTexture", &Material::base_color_texture},
+    {"metallicRoughnessTexture", &Material::metallic_roughness_texture},
+    {"normalTexture", &Material::normal_texture},
+    {"emissiveTexture", &Material::emissive_texture}};
+
 // What of a material mcrt does not render, once per kind.
 void warn_unsupported_parts(const tinygltf::Material& material, Diagnostics& diag) {
     if (material.occlusionTexture.index != -1) {
@@ -168,6 +180,31 @@ uint32_t MaterialTable::slot(int material_index, const std::string& referrer) {
     const uint32_t index = static_cast<uint32_t>(materials_.size());
     materials_.push_back(material);
     slots_.emplace(material_index, index);
+    return index;
+}
+
+uint32_t MaterialTable::slot_for_texcoords(uint32_t slot, uint32_t texcoord_sets,
+                                           std::string& left_out) {
+    left_out.clear();
+    uint32_t missing = 0;
+    const Material& material = materials_[slot];
+    for (size_t k = 0; k < std::size(kTextureSlots); ++k) {
+        const TextureRef& ref = material.*kTextureSlots[k].ref;
+        if (!ref.used() || (texcoord_sets >> ref.texcoord & 1u)) continue;
+        missing |= 1u << k;
+        left_out += std::string(left_out.empty() ? "" : ", ") + kTextureSlots[k].name +
+                    " (TEXCOORD_" + std::to_string(ref.texcoord) + ")";
+    }
+    if (missing == 0) return slot;
+    const auto found = copies_.find({slot, missing});
+    if (found != copies_.end()) return found->second;
+    Material copy = material;
+    for (size_t k = 0; k < std::size(kTextureSlots); ++k) {
+        if (missing >> k & 1u) copy.*kTextureSlots[k].ref = TextureRef{};
+    }
+    const uint32_t index = static_cast<uint32_t>(materials_.size());
+    materials_.push_back(copy);
+    copies_.emplace(std::make_pair(slot, missing), index);
     return index;
 }
 

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "scene/gltf_diagnostics.h"
@@ -30,6 +31,14 @@ class MaterialTable {
     // `referrer` names the element that refers to it.
     uint32_t slot(int material_index, const std::string& referrer);
 
+    // The slot of the material at `slot` as a primitive with the TEXCOORD_n sets `texcoord_sets`
+    // (bit n) sees it: glTF 2.0 "Texture Data" says a primitive MUST have the set a texture
+    // reads for the material to apply, so a texture reading a set the primitive lacks is left
+    // out, in a copy of the material made once per slot and set of textures left out (the
+    // factors alone apply: texel (0, 0) would be read everywhere). `left_out` gets their names
+    // and sets, "baseColorTexture (TEXCOORD_1)", empty when none is.
+    uint32_t slot_for_texcoords(uint32_t slot, uint32_t texcoord_sets, std::string& left_out);
+
   private:
     Material convert(int material_index, const std::string& referrer);
 
@@ -38,6 +47,8 @@ class MaterialTable {
     TextureTable& textures_;
     std::vector<Material>& materials_;
     std::map<int, uint32_t> slots_;  // glTF material index (−1: default) → slot
+    // (slot, texture slots left out as bits of kTextureSlots) → slot of the copy
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> copies_;
 };
 
 }  // namespace mcrt::gltf
