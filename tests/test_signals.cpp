@@ -1,6 +1,6 @@
-// A render stopped by SIGTERM, SIGINT or SIGHUP at any moment — loading the scene, building kernels,
-// rendering, writing — leaves either no output file or a complete, valid EXR (of whole chunk
-// rows), never a truncated one, and no temporary file behind (DESIGN.md "Exit status").
+// A render stopped by SIGTERM, SIGINT or SIGHUP at any moment — loading the scene, building
+// kernels, rendering, writing — leaves either no output file or a complete, valid EXR (of whole
+// chunk rows), never a truncated one, and no temporary file behind (DESIGN.md "Exit status").
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>

@@ -223,10 +223,10 @@ TEST_CASE("a job stopped longer than its time limit ends with what it has when c
     for (const bool both : {true, false}) {
         DYNAMIC_SECTION((both ? "supervisor and render stopped" : "render stopped alone")) {
             TempDir out("mcrt-sup-out"), logs("mcrt-sup-logs");
-            Child child({MCRT_EXE, "render", kCornell, "--width", "64", "--height", "48", "--spp",
-                         "1000000", "--time-limit", "1", "--out", out / "a.exr", "--stats",
-                         out / "a.json"},
-                        {}, logs / "log");
+            Child child(
+                {MCRT_EXE, "render", kCornell, "--width", "64", "--height", "48", "--spp",
+                 "1000000", "--time-limit", "1", "--out", out / "a.exr", "--stats", out / "a.json"},
+                {}, logs / "log");
             REQUIRE(child.wait_for_text(" spp ", 120));
             const pid_t render = child.render_pid();
             REQUIRE(render != child.pid());
@@ -234,7 +234,8 @@ TEST_CASE("a job stopped longer than its time limit ends with what it has when c
             if (both) child.signal(SIGSTOP);
             CHECK(wait_for_state(render, 'T', true, 10));
             // Past the time limit and the grace period after it.
-            std::this_thread::sleep_for(std::chrono::duration<double>(1 + kSupervisorGraceSeconds + 1.5));
+            std::this_thread::sleep_for(
+                std::chrono::duration<double>(1 + kSupervisorGraceSeconds + 1.5));
             if (both) {  // the supervisor first: it must not take the stopped render for stuck
                 child.signal(SIGCONT);
                 CHECK(wait_for_state(child.pid(), 'T', false, 10));
@@ -289,9 +290,11 @@ TEST_CASE("an .icd file the ICD loader would crash or block on is named before i
                 if (command == "bench" || command == "render")
                     args.insert(args.end(), {kCornell, "--width", "8", "--height", "8"});
                 if (command == "bench") args.insert(args.end(), {"--repeats", "1"});
-                if (command == "render") args.insert(args.end(), {"--quiet", "--out", out / "a.exr"});
+                if (command == "render")
+                    args.insert(args.end(), {"--quiet", "--out", out / "a.exr"});
                 if (command == "integrate")
-                    args.insert(args.end(), {"--n", "16", "--repeats", "2", "--out", out / "i.csv"});
+                    args.insert(args.end(),
+                                {"--n", "16", "--repeats", "2", "--out", out / "i.csv"});
                 setenv("OCL_ICD_VENDORS", icd.path().c_str(), 1);
                 const ProcessResult r = run_process(MCRT_EXE, args, logs.path(), 60);
                 unsetenv("OCL_ICD_VENDORS");
@@ -359,7 +362,8 @@ TEST_CASE("a device whose context is refused is skipped under --device all",
                                         "--spp", "32", "--quiet", "--out", out, "--device", device};
     };
     setenv("POCL_DEVICES", "pthread basic", 1);
-    const ProcessResult reference = run_process(MCRT_EXE, args(dir / "b.exr", "1"), logs.path(), 120);
+    const ProcessResult reference =
+        run_process(MCRT_EXE, args(dir / "b.exr", "1"), logs.path(), 120);
     setenv("MCRT_TEST_CONTEXT_FAILURE", "0", 1);
     const ProcessResult all = run_process(MCRT_EXE, args(dir / "a.exr", "all"), logs.path(), 120);
     const ProcessResult only = run_process(MCRT_EXE, args(dir / "c.exr", "0"), logs.path(), 120);

@@ -88,8 +88,8 @@ std::vector<std::unique_ptr<DeviceContext>> open_devices(
         } catch (const RuntimeError& e) {
             if (devices.size() == 1 || (contexts.empty() && &d == &devices.back())) throw;
             if (warn)
-                warn("skipping device " + std::to_string(d.index) + " ('" + d.name + "'): " +
-                     e.what());
+                warn("skipping device " + std::to_string(d.index) + " ('" + d.name +
+                     "'): " + e.what());
         }
     }
     return contexts;

@@ -131,8 +131,8 @@ int run_cli(int argc, char** argv) {
     add_integrate_command(app, integrate_options);
     refuse_empty_values(app);  // every string-valued option of every subcommand
 
-    std::string refused;        // a usage error
-    std::exception_ptr help;    // --help, printed once the ranks agree
+    std::string refused;      // a usage error
+    std::exception_ptr help;  // --help, printed once the ranks agree
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp&) {

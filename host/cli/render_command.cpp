@@ -66,7 +66,7 @@ struct InterruptGuard {
         for (size_t i = 0; i < std::size(kStopSignals); ++i)
             sigaction(kStopSignals[i], &old[i], nullptr);
     }
-    struct sigaction old[std::size(kStopSignals)] {};
+    struct sigaction old[std::size(kStopSignals)]{};
 };
 
 glm::vec3 parse_sky(const std::string& text) {

@@ -334,9 +334,9 @@ int supervise(const std::string& command, pid_t pid, int fd) {
         if (forwarded != 0 && w.stage != Stage::kWriting && w.stage != Stage::kDone &&
             seconds_since(forwarded_at) > kSupervisorGraceSeconds) {
             kill_and_reap(pid, &status);
-            print_error(w, "stopped by " + signal_abbreviation(forwarded) + ", but " +
-                               stuck_where(w, "") +
-                               (w.command == "render" ? "; no image was written" : "; it was killed"));
+            print_error(
+                w, "stopped by " + signal_abbreviation(forwarded) + ", but " + stuck_where(w, "") +
+                       (w.command == "render" ? "; no image was written" : "; it was killed"));
             return 1;
         }
         if (w.stage == Stage::kLaunch && w.time_limit > 0 &&

@@ -133,8 +133,8 @@ int agree_on_command(const std::vector<std::string>& command, const std::string&
         }
         all.resize(total);
     }
-    MPI_Gatherv(mine.data(), length, MPI_CHAR, all.data(), lengths.data(), offsets.data(),
-                MPI_CHAR, 0, MPI_COMM_WORLD);
+    MPI_Gatherv(mine.data(), length, MPI_CHAR, all.data(), lengths.data(), offsets.data(), MPI_CHAR,
+                0, MPI_COMM_WORLD);
     uint64_t status = 0;
     if (g_rank == 0) {
         if (!refused.empty()) status = 2;  // rank 0's caller prints its own usage error
@@ -312,8 +312,8 @@ void serve_device(RenderWorker& worker, int slot) {
 int serve_render(const std::function<RenderRequest()>& make_request,
                  const std::vector<std::string>& device_names) {
     // Rank 0 decides when the render stops (its signals, its time limit) and tells every rank;
-    // mpirun's SIGTERM to all ranks at Ctrl-C (or a SIGHUP) must not end this one before rank 0 has the
-    // samples it is rendering.
+    // mpirun's SIGTERM to all ranks at Ctrl-C (or a SIGHUP) must not end this one before rank 0 has
+    // the samples it is rendering.
     for (int sig : kStopSignals) std::signal(sig, SIG_IGN);
 
     const uint64_t go = mpi::broadcast_u64(0, 0);
