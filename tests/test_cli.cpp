@@ -13,6 +13,7 @@
 #include <tuple>
 #include <vector>
 
+#include "cli/render_command.h"
 #include "common/environment.h"
 #include "image/image.h"
 #include "render/variants.h"
@@ -431,6 +432,68 @@ TEST_CASE("NaN option values are rejected", "[cli]") {
     }
 }
 
+// A number's refusal says why: a denormal (4.9e-324) is finite and accepted; a value that rounds
+// to 0 or overflows double is refused as such, not called "not a finite number".
+TEST_CASE("floating-point option values are refused with their true reason", "[cli]") {
+    const std::pair<const char*, const char*> refused[] = {
+        {"1e-400", "'1e-400' is too small to tell from 0"},
+        {"1e400", "'1e400' is beyond the largest finite number"},
+        {"inf", "'inf' is not a finite number"},
+        {"12s", "'12s' is not a number"}};
+    for (const auto& [value, said] : refused) {
+        Sandbox box;
+        ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("x.exr"),
+                                          "--time-limit", value},
+                                         kSmall));
+        INFO(value << "\n  stderr: " << r.err);
+        check_usage_error(r);
+        CHECK(r.err.find(std::string("--time-limit: ") + said) != std::string::npos);
+        CHECK(box.files().empty());
+    }
+    // A float option too: an --ao-distance that rounds to 0 in float would be "unbounded".
+    {
+        Sandbox box;
+        ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("x.exr"),
+                                          "--estimator", "ambient-uniform", "--ao-distance",
+                                          "1e-50"},
+                                         kSmall));
+        INFO(r.err);
+        check_usage_error(r);
+        CHECK(r.err.find("--ao-distance: '1e-50' is too small to tell from 0 (the smallest is "
+                         "1.4e-45)") != std::string::npos);
+        CHECK(box.files().empty());
+    }
+    // A sky radiance below float's smallest is in [0, 1e30] (it rounds as any float does); a
+    // trailing comma is no value.
+    {
+        Sandbox box;
+        ProcessResult tiny = box.run(concat({"render", kCornell, "--out", box.out("x.exr"),
+                                             "--estimator", "ambient-uniform", "--sky", "1e-50"},
+                                            kSmall));
+        INFO(tiny.err);
+        CHECK(tiny.exit_code == 0);
+        ProcessResult comma = box.run(concat({"render", kCornell, "--out", box.out("y.exr"),
+                                              "--sky", "1,"},
+                                             kSmall));
+        INFO(comma.err);
+        check_usage_error(comma);
+        CHECK(comma.err.find("--sky 1,: expected R,G,B or one value") != std::string::npos);
+    }
+    // The smallest positive double is a time limit: the render stops at its first check, with
+    // its first chunk row (the supervisor is told the limit with every digit, not "0.000000").
+    Sandbox box;
+    const std::string exr = box.out("t.exr"), stats = box.out("t.json");
+    ProcessResult r = box.run({"render", kCornell, "--out", exr, "--stats", stats, "--width", "16",
+                               "--height", "16", "--spp", "65536", "--quiet", "--time-limit",
+                               "4.9e-324"});
+    INFO("stderr: " << r.err);
+    REQUIRE(r.exit_code == 0);
+    const nlohmann::json j = nlohmann::json::parse(read_whole_file(stats));
+    CHECK(j["stopped_by"] == "time limit");
+    CHECK(j["spp"].get<int>() < 65536);
+    CHECK(j["spp"].get<int>() >= 16);
+}
+
 TEST_CASE("broken and valid glTF files in tests/data render or are rejected cleanly", "[cli][robustness]") {
     std::vector<fs::path> files = gltf_files(MCRT_TEST_DATA, false);
     REQUIRE_FALSE(files.empty());
@@ -689,4 +752,27 @@ TEST_CASE("non-finite samples are counted, warned about, and an image of nothing
             CHECK(box.files().empty());
         }
     }
+}
+
+TEST_CASE("every render option but --device is in the words the MPI ranks compare", "[cli][mpi]") {
+    // render_option_words is what rank 0 compares every rank's command line against
+    // (agree_on_command): an option left out of it would let a rank render with its own.
+    CLI::App app;
+    RenderOptions o;
+    CLI::App* render = add_render_command(app, o);
+    const std::vector<std::string> words = render_option_words(o);
+    size_t checked = 0;
+    for (const CLI::Option* option : render->get_options()) {
+        std::string name = option->get_name();
+        if (name == "--help" || name == "--device") continue;
+        if (name.rfind("--", 0) != 0) name = "the " + name;  // the scene positional
+        INFO(name);
+        const bool found = std::any_of(words.begin(), words.end(), [&](const std::string& w) {
+            return w == name || w == "no " + name || w.rfind(name + " ", 0) == 0;
+        });
+        CHECK(found);
+        ++checked;
+    }
+    CHECK(checked >= 25);
+    CHECK(words.size() == checked);  // one word per option, none twice
 }

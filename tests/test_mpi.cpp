@@ -317,6 +317,10 @@ TEST_CASE("bad input under mpirun: every rank exits 2, with one error line", "[m
         {"missing scene", {"render", dir / "none.gltf", "--out", dir / "x.exr"}},
         {"unknown option", {"render", kCornell, "--out", dir / "x.exr", "--no-such-option"}},
         {"bad camera", {"render", kCornell, "--out", dir / "x.exr", "--camera", "9"}},
+        // Read into the request after parsing: each rank reads them, rank 0 alone says so.
+        {"bad sky", {"render", kCornell, "--out", dir / "x.exr", "--sky", "abc"}},
+        {"bad look-from",
+         {"render", kCornell, "--out", dir / "x.exr", "--look-from", "1,2", "--look-at", "0,0,0"}},
         {"estimator that does not build",
          {"render", kCornell, "--out", dir / "x.exr", "--width", "8", "--height", "8",
           "--estimator-file", dir / "bad.cl"}},
@@ -470,4 +474,85 @@ TEST_CASE(
     CHECK(stats["ranks"][1]["devices_retired"] == 1);
     REQUIRE(spp > 0);
     CHECK(same_bits(read_exr(dir / "recovered.exr").rgb, one_process_render(dir, spp).rgb));
+}
+
+namespace {
+
+// `mpirun -n 1 mcrt RANK0... : -n 1 mcrt RANK1...` (MPMD: each rank its own command line).
+ProcessResult run_mpmd(const std::vector<std::string>& rank0, const std::vector<std::string>& rank1,
+                       const TempDir& dir, double timeout = 60) {
+    std::vector<std::string> a = {"--bind-to", "none", "--oversubscribe", "-n", "1", MCRT_EXE};
+    a.insert(a.end(), rank0.begin(), rank0.end());
+    a.insert(a.end(), {":", "-n", "1", MCRT_EXE});
+    a.insert(a.end(), rank1.begin(), rank1.end());
+    return run_process(mpirun(), a, dir.path(), timeout);
+}
+
+}  // namespace
+
+TEST_CASE("a rank started with other options ends the job at once, naming the option",
+          "[mpi][cli]") {
+    // Rank 0's command line is the request: a rank that reads another (it rendered its items
+    // with its own image size, estimator or seed: a wrong image, exit 0) or refuses its own
+    // (--spp 0: rank 0 waited 120 s for it) is one error line and exit 2 on every rank.
+    mpirun();
+    TempDir dir;
+    struct Case {
+        const char* what;
+        std::vector<std::string> rank1_extra;
+        const char* said;
+    };
+    const std::vector<Case> cases = {
+        {"image size", {"--width", "32"}, "rank 1 was started with --width 32, rank 0 with --width 48"},
+        {"estimator", {"--estimator", "mis"}, "rank 1 was started with --estimator mis, rank 0 with --estimator light-area"},
+        {"seed", {"--seed", "7"}, "rank 1 was started with --seed 7, rank 0 with --seed 0"},
+        {"an output only rank 1 names", {"--png", dir / "x.png"}, "rank 1 was started with --png"},
+        {"an invalid value", {"--spp", "0"}, "rank 1 refused its command line: --spp: Value 0 not in range"},
+        {"an unknown option", {"--no-such-option"}, "rank 1 refused its command line: "},
+    };
+    for (const Case& c : cases) {
+        DYNAMIC_SECTION(c.what) {
+            std::vector<std::string> rank0 = {"render", kCornell, "--height", "40", "--quiet",
+                                              "--out", dir / "x.exr"};
+            std::vector<std::string> rank1 = rank0;
+            rank0.insert(rank0.end(), {"--width", "48"});
+            if (c.rank1_extra.front() != "--width") rank1.insert(rank1.end(), {"--width", "48"});
+            rank1.insert(rank1.end(), c.rank1_extra.begin(), c.rank1_extra.end());
+            const auto start = std::chrono::steady_clock::now();
+            const ProcessResult r = run_mpmd(rank0, rank1, dir, 90);
+            const double seconds =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            INFO("stderr: " << r.err);
+            REQUIRE_FALSE(r.timed_out);
+            CHECK(r.exit_code == 2);
+            CHECK(seconds < 30);  // not rank 0's 120 s wait for a rank that never comes
+            const std::vector<std::string> errors = lines_starting_with(r.err, "mcrt: error:");
+            REQUIRE(errors.size() == 1);
+            CHECK(errors[0].find(c.said) != std::string::npos);
+            CHECK_FALSE(std::filesystem::exists(dir / "x.exr"));
+            CHECK_FALSE(std::filesystem::exists(dir / "x.png"));
+        }
+    }
+}
+
+TEST_CASE("ranks may differ in --device alone, and another command on a rank ends the job",
+          "[mpi][cli]") {
+    mpirun();
+    TempDir dir;
+    ProcessResult one = run_process(MCRT_EXE, render_args(dir / "one.exr"), dir.path());
+    REQUIRE(one.exit_code == 0);
+    const ProcessResult r = run_mpmd(render_args(dir / "two.exr", {"--device", "0"}),
+                                     render_args(dir / "two.exr", {"--device", "all"}), dir);
+    INFO("stderr: " << r.err);
+    REQUIRE(r.exit_code == 0);
+    CHECK(same_bits(read_exr(dir / "one.exr").rgb, read_exr(dir / "two.exr").rgb));
+    // A rank that runs another subcommand.
+    const ProcessResult other = run_mpmd(render_args(dir / "three.exr"), {"devices"}, dir);
+    INFO("stderr: " << other.err);
+    REQUIRE_FALSE(other.timed_out);
+    CHECK(other.exit_code == 2);
+    const std::vector<std::string> errors = lines_starting_with(other.err, "mcrt: error:");
+    REQUIRE(errors.size() == 1);
+    CHECK(errors[0].find("rank 1 runs mcrt devices, rank 0 mcrt render") != std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(dir / "three.exr"));
 }

@@ -1,13 +1,15 @@
-// A render stopped by SIGTERM or SIGINT at any moment — loading the scene, building kernels,
-// rendering, writing — leaves either no output file or a complete, valid EXR (of whole chunk
-// rows), never a truncated one, and no temporary file behind (DESIGN.md "Exit status").
+// A render stopped by SIGTERM, SIGINT or SIGHUP at any moment — loading the scene, building
+// kernels, rendering, writing — leaves either no output file or a complete, valid EXR (of whole
+// chunk rows), never a truncated one, and no temporary file behind (DESIGN.md "Exit status").
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <thread>
 
+#include "hostile_support.h"
 #include "image/image.h"
 #include "process_support.h"
 
@@ -127,4 +129,52 @@ TEST_CASE("SIGTERM ends a render on a slow device within seconds", "[signals][cl
         }
     }
     unsetenv("MCRT_SLOW_DEVICE");
+}
+
+TEST_CASE("SIGHUP mid-render stops it as SIGINT does: the samples done, written, exit 0",
+          "[signals][cli][supervisor]") {
+    // A closed terminal or ssh session. The render's progress bar shows that the kernels run.
+    TempDir dir("mcrt-signals"), logs("mcrt-signals-logs");
+    Child child({MCRT_EXE, "render", kCornell, "--width", "64", "--height", "48", "--spp",
+                 "1000000", "--out", dir / "out.exr", "--stats", dir / "out.json"},
+                {}, logs / "log");
+    REQUIRE(child.wait_for_text(" spp ", 120));
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    child.signal(SIGHUP);
+    const int status = child.wait(60);
+    INFO(child.output());
+    REQUIRE_FALSE(child.timed_out());
+    REQUIRE(WIFEXITED(status));  // it died of SIGHUP (129) before
+    CHECK(WEXITSTATUS(status) == 0);
+    CHECK(child.output().find("stopped by interrupt") != std::string::npos);
+    ProcessResult as_if;  // check_outputs' view of it
+    as_if.exit_code = WEXITSTATUS(status);
+    as_if.err = child.output();
+    check_outputs(dir.path(), as_if, 64, 48);
+    CHECK(files_in(dir.path()) == std::vector<std::string>{"out.exr", "out.json"});
+    const nlohmann::json stats = nlohmann::json::parse(read_whole_file(dir / "out.json"));
+    CHECK(stats["stopped_by"] == "interrupt");
+}
+
+TEST_CASE("under nohup (SIGHUP ignored) a SIGHUP leaves the render to finish",
+          "[signals][cli][supervisor]") {
+    TempDir dir("mcrt-signals"), logs("mcrt-signals-logs");
+    struct sigaction ignore {}, old{};
+    ignore.sa_handler = SIG_IGN;
+    sigemptyset(&ignore.sa_mask);
+    sigaction(SIGHUP, &ignore, &old);  // inherited across posix_spawn and exec, as nohup does
+    Child child({MCRT_EXE, "render", kCornell, "--width", "32", "--height", "32", "--spp", "4096",
+                 "--out", dir / "out.exr", "--stats", dir / "out.json"},
+                {}, logs / "log");
+    sigaction(SIGHUP, &old, nullptr);
+    REQUIRE(child.wait_for_text(" spp ", 120));
+    child.signal(SIGHUP);
+    ::kill(child.render_pid(), SIGHUP);
+    const int status = child.wait(120);
+    INFO(child.output());
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 0);
+    const nlohmann::json stats = nlohmann::json::parse(read_whole_file(dir / "out.json"));
+    CHECK(stats["spp"] == 4096);
+    CHECK(stats["stopped_by"] == "");
 }

@@ -87,3 +87,37 @@ TEST_CASE("every OpenCL implementation renders the same bytes, alone and togethe
         }
     }
 }
+
+TEST_CASE("Intel's runtime refusing its context costs its device alone under --device all",
+          "[vendors]") {
+    // CL_CONFIG_CPU_TARGET_ARCH=junk: Intel's CPU runtime lists its device, then refuses a
+    // context for it (CL_DEVICE_NOT_AVAILABLE); the render goes on with PoCL's device, as it
+    // does when a device's compiler crashes.
+    const std::map<std::string, int> platforms = one_device_per_platform();
+    int intel = -1;
+    for (const auto& [name, index] : platforms)
+        if (name.find("Intel") != std::string::npos) intel = index;
+    if (intel < 0 || platforms.size() < 2)
+        skip_test("Intel's runtime beside another implementation is needed (scripts/with-intel)");
+    TempDir dir;
+    auto args = [&](const std::string& out, const std::string& device) {
+        return std::vector<std::string>{"render", kCornell, "--width", "24", "--height", "16",
+                                        "--spp", "16", "--quiet", "--out", out, "--device", device};
+    };
+    int other = -1;
+    for (const auto& [name, index] : platforms)
+        if (index != intel) other = index;
+    const ProcessResult reference =
+        run_process(MCRT_EXE, args(dir / "b.exr", std::to_string(other)), dir.path(), 300);
+    setenv("CL_CONFIG_CPU_TARGET_ARCH", "junk", 1);
+    const ProcessResult all = run_process(MCRT_EXE, args(dir / "a.exr", "all"), dir.path(), 300);
+    unsetenv("CL_CONFIG_CPU_TARGET_ARCH");
+    INFO(reference.err << all.err);
+    REQUIRE(reference.exit_code == 0);
+    CHECK(all.exit_code == 0);
+    const std::vector<std::string> warnings = lines_starting_with(all.err, "mcrt: warning:");
+    REQUIRE(warnings.size() == 1);
+    CHECK(warnings[0].find("skipping device " + std::to_string(intel)) != std::string::npos);
+    CHECK(warnings[0].find("clCreateContext failed") != std::string::npos);
+    CHECK(read_whole_file(dir / "a.exr") == read_whole_file(dir / "b.exr"));
+}

@@ -1,6 +1,8 @@
 #include "cl/device.h"
 
 #include "cl/cl_error.h"
+#include "cl/no_device.h"
+#include "common/test_hooks.h"
 
 namespace mcrt {
 
@@ -23,6 +25,7 @@ static T device_info(const cl::Device& device) {
 }
 
 std::vector<DeviceInfo> enumerate_devices(const std::function<void(const std::string&)>& warn) {
+    check_icd_files();  // the loader would block or crash on them
     std::vector<cl::Platform> platforms;
     cl_int status = cl::Platform::get(&platforms);
     // The ICD loader answers CL_PLATFORM_NOT_FOUND_KHR (-1001) when no platform is installed.
@@ -70,6 +73,7 @@ std::vector<DeviceInfo> enumerate_devices(const std::function<void(const std::st
 DeviceContext::DeviceContext(const DeviceInfo& info_) : info(info_) {
     cl_int status = CL_SUCCESS;
     context = cl::Context(info.device, nullptr, nullptr, nullptr, &status);
+    if (test_context_failure(info.index)) status = CL_DEVICE_NOT_AVAILABLE;
     CL_CHECK_STATUS(status, "clCreateContext");
     queue = cl::CommandQueue(context, info.device, CL_QUEUE_PROFILING_ENABLE, &status);
     CL_CHECK_STATUS(status, "clCreateCommandQueue");

@@ -1,8 +1,11 @@
 #include "cl/no_device.h"
 
 #include "common/environment.h"
+#include "common/error.h"
+#include "common/regular_file.h"
 
 #include <dlfcn.h>
+#include <sys/stat.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -111,6 +114,22 @@ std::vector<fs::path> icd_files() {
     return files;
 }
 
+// An ICD file the loader cannot read safely, as words ("starts with a NUL byte, ..."), or "".
+std::string icd_file_problem(const fs::path& file) {
+    struct stat st {};
+    if (::stat(file.c_str(), &st) != 0 || S_ISDIR(st.st_mode)) return {};  // skipped by the loader
+    if (!S_ISREG(st.st_mode))
+        return "is " + file_kind_name(st.st_mode) + ", which the ICD loader would wait on forever";
+    std::vector<unsigned char> first;
+    std::string why;
+    FileSizeLimits limits;
+    limits.read_bytes = 1;
+    if (!read_regular_file(file.string(), first, why, limits)) return {};  // the loader skips it
+    if (!first.empty() && first[0] == 0)
+        return "starts with a NUL byte (it names no library), which the ICD loader crashes on";
+    return {};
+}
+
 // The address-space limit (ulimit -v) as words, or "" when there is none.
 std::string address_space_limit() {
     struct rlimit limit {};
@@ -144,6 +163,18 @@ std::string pocl_cache_problem() {
     if (why.empty()) return {};
     return "PoCL's kernel cache directory " + cache + " cannot be created (" + why +
            "); set POCL_CACHE_DIR to a writable directory";
+}
+
+void check_icd_files() {
+    for (const fs::path& file : icd_files()) {
+        const std::string problem = icd_file_problem(file);
+        if (problem.empty()) continue;
+        const char* vendors = environment(kEnvOclIcdVendors);
+        throw RuntimeError("the OpenCL ICD file " + file.string() + " " + problem +
+                           "; remove it" +
+                           (vendors && *vendors ? ", or set OCL_ICD_VENDORS to a directory without it"
+                                                : ""));
+    }
 }
 
 std::string no_device_message() {

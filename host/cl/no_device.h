@@ -12,6 +12,11 @@ namespace mcrt {
 // else the plain message.
 std::string no_device_message();
 
+// Before the ICD loader reads its vendor files (OCL_ICD_VENDORS, else /etc/OpenCL/vendors): throws
+// RuntimeError naming an .icd file that it would wait on forever (a FIFO, a device) or crash on
+// (ocl-icd 2.3 dies of SIGSEGV on one that starts with a NUL byte).
+void check_icd_files();
+
 // "PoCL's kernel cache directory /x/pocl cannot be created (/x is not a directory); set
 // POCL_CACHE_DIR to a writable directory", or "" when it is usable. PoCL then finds no device,
 // or, with a device already set up, fails every kernel build without a log.

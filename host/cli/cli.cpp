@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cstring>
 #include <cstdio>
+#include <exception>
 #include <iostream>
 #include <system_error>
 
@@ -104,7 +105,7 @@ CLI::App* add_bench_command(CLI::App& app, BenchOptions& o, CameraOptions& look)
     cmd->add_option("--bvh-traversal-cost", o.bvh.traversal_cost,
                     "SAH cost of a node visit, in packet tests")
         ->capture_default_str()
-        ->check(kFinite)
+        ->check(kFiniteFloat)
         ->check(CLI::Range(0.0f, 100.0f));
     return cmd;
 }
@@ -130,16 +131,41 @@ int run_cli(int argc, char** argv) {
     add_integrate_command(app, integrate_options);
     refuse_empty_values(app);  // every string-valued option of every subcommand
 
+    std::string refused;      // a usage error
+    std::exception_ptr help;  // --help, printed once the ranks agree
     try {
         app.parse(argc, argv);
-    } catch (const CLI::CallForHelp& e) {
-        return app.exit(e);
-    } catch (const CLI::CallForAllHelp& e) {
-        return app.exit(e);
+    } catch (const CLI::CallForHelp&) {
+        help = std::current_exception();
+    } catch (const CLI::CallForAllHelp&) {
+        help = std::current_exception();
     } catch (const CLI::ParseError& e) {
-        // Under mpirun every rank parses the same arguments: rank 0 alone says what is wrong.
-        if (job_rank() == 0)
-            std::cerr << "mcrt: error: " << usage_error_message(app, e, argc, argv) << std::endl;
+        refused = usage_error_message(app, e, argc, argv);
+    }
+    // Under mpirun every rank reads its own command line: rank 0's is the request, and a rank
+    // that reads another (other options, a usage error of its own) ends the job at once.
+    if (job_size() > 1) {
+        std::vector<std::string> command = {std::string("mcrt ") + (argc > 1 ? argv[1] : "") +
+                                            (help ? " --help" : "")};
+        if (refused.empty() && !help && app.got_subcommand("render")) {
+            const std::vector<std::string> words = render_option_words(render_options);
+            command.insert(command.end(), words.begin(), words.end());
+        }
+        if (const int status = agree_on_command(command, refused); status != 0) {
+            if (job_rank() == 0 && !refused.empty())
+                std::cerr << "mcrt: error: " << refused << std::endl;
+            return status;
+        }
+    }
+    if (help) {
+        try {
+            std::rethrow_exception(help);
+        } catch (const CLI::ParseError& e) {
+            return app.exit(e);
+        }
+    }
+    if (!refused.empty()) {
+        std::cerr << "mcrt: error: " << refused << std::endl;
         return 2;
     }
 

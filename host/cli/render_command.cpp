@@ -4,10 +4,12 @@
 #include <cstdio>
 #include <chrono>
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <map>
 #include <sstream>
 
@@ -43,8 +45,9 @@ volatile std::sig_atomic_t g_interrupted = 0;
 
 extern "C" void on_interrupt(int) { g_interrupted = 1; }
 
-// While a render runs, SIGINT and SIGTERM ask it to stop and write the samples done so far;
-// a second signal ends the process at once.
+// While a render runs, SIGINT, SIGTERM and SIGHUP (kStopSignals) ask it to stop and write the
+// samples done so far; a second signal ends the process at once. SIGHUP stays ignored where the
+// process started with it ignored (nohup).
 struct InterruptGuard {
     InterruptGuard() {
         g_interrupted = 0;
@@ -54,16 +57,18 @@ struct InterruptGuard {
         action.sa_handler = on_interrupt;
         action.sa_flags = SA_RESETHAND;
         sigemptyset(&action.sa_mask);
-        sigaction(SIGINT, &action, &old_int);
-        sigaction(SIGTERM, &action, &old_term);
+        for (size_t i = 0; i < std::size(kStopSignals); ++i) {
+            sigaction(kStopSignals[i], nullptr, &old[i]);
+            if (ignored_at_start(kStopSignals[i])) continue;
+            sigaction(kStopSignals[i], &action, nullptr);
+        }
     }
     ~InterruptGuard() {
         if (outputs_are_complete()) return;  // stop signals stay ignored: nothing left to save
-        sigaction(SIGINT, &old_int, nullptr);
-        sigaction(SIGTERM, &old_term, nullptr);
+        for (size_t i = 0; i < std::size(kStopSignals); ++i)
+            sigaction(kStopSignals[i], &old[i], nullptr);
     }
-    struct sigaction old_int {
-    }, old_term{};
+    struct sigaction old[std::size(kStopSignals)]{};
 };
 
 glm::vec3 parse_sky(const std::string& text) {
@@ -71,16 +76,17 @@ glm::vec3 parse_sky(const std::string& text) {
     std::stringstream in(text);
     std::string item;
     while (std::getline(in, item, ',')) {
-        try {
-            size_t used = 0;
-            float x = std::stof(item, &used);
-            if (used != item.size() || !std::isfinite(x) || x < 0 || x > kMaxRadiance)
-                throw std::invalid_argument(item);
-            v.push_back(x);
-        } catch (const std::exception&) {
+        // Checked as a double: std::stof refused a radiance below float's smallest (1e-50) as
+        // out of range though it is in [0, 1e30]; as a float it is 0 or a denormal.
+        char* end = nullptr;
+        const double x = std::strtod(item.c_str(), &end);
+        if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(x) || x < 0 ||
+            x > kMaxRadiance)
             throw InputError("--sky " + text + ": expected R,G,B or one value, each in [0, 1e30]");
-        }
+        v.push_back(std::strtof(item.c_str(), nullptr));  // rounded once, as std::stof did
     }
+    if (!text.empty() && text.back() == ',')  // getline drops the empty last value
+        throw InputError("--sky " + text + ": expected R,G,B or one value");
     if (v.size() == 1) return glm::vec3(v[0]);
     if (v.size() == 3) return glm::vec3(v[0], v[1], v[2]);
     throw InputError("--sky " + text + ": expected R,G,B or one value");
@@ -180,6 +186,46 @@ InputError flag_error(const SettingError& e) {
     return InputError(flag + " " + e.detail);
 }
 
+std::vector<std::string> render_option_words(const RenderOptions& o) {
+    auto text = [](const char* name, const std::string& value) {
+        return value.empty() ? std::string("no ") + name : std::string(name) + " " + value;
+    };
+    auto number = [](const char* format, double v) {
+        char digits[40];
+        std::snprintf(digits, sizeof digits, format, v);
+        return std::string(digits);
+    };
+    auto flag = [](const char* name, bool on) { return (on ? "" : std::string("no ")) + name; };
+    return {"the scene " + o.scene,
+            text("--out", o.out),
+            text("--png", o.png),
+            text("--stats", o.stats),
+            "--width " + std::to_string(o.width),
+            "--height " + std::to_string(o.height),
+            "--spp " + std::to_string(o.spp),
+            "--estimator " + o.estimator,
+            text("--estimator-file", o.estimator_file),
+            "--light-select " + o.light_select,
+            "--sampler " + o.sampler,
+            "--mis-heuristic " + o.mis_heuristic,
+            "--materials " + o.materials,
+            "--seed " + std::to_string(o.seed),
+            text("--sky", o.sky),
+            "--max-depth " + std::to_string(o.max_depth),
+            "--rr-depth " + std::to_string(o.rr_depth),
+            "--ao-distance " + number("%.9g", o.ao_distance),
+            o.camera < 0 ? "no --camera" : "--camera " + std::to_string(o.camera),
+            text("--look-from", o.look.look_from),
+            text("--look-at", o.look.look_at),
+            "--up " + o.look.up,
+            "--fov " + number("%.9g", o.look.fov),
+            "--batch " + std::to_string(o.batch),
+            "--replicates " + std::to_string(o.replicates),
+            o.time_limit > 0 ? "--time-limit " + number("%.17g", o.time_limit) : "no --time-limit",
+            "--exposure " + number("%.9g", o.exposure),
+            flag("--quiet", o.quiet)};
+}
+
 CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
     CLI::App* cmd = app.add_subcommand("render", "render a glTF scene to EXR");
     cmd->add_option("scene", o.scene, "glTF scene (.gltf or .glb)")->required();
@@ -233,7 +279,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
         ->check(CLI::Range(1u, MCRT_MAX_PATH_DEPTH));
     cmd->add_option("--ao-distance", o.ao_distance, "ambient occlusion distance, 0 = unbounded")
         ->capture_default_str()
-        ->check(kFinite)
+        ->check(kFiniteFloat)
         ->check(CLI::Range(0.0f, 3.4e38f));
     CLI::Option* camera = cmd->add_option("--camera", o.camera, "glTF camera index in the scene (cameras[K])")
                               ->check(CLI::Range(0, 1 << 30));
@@ -254,7 +300,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
         ->check(CLI::Range(0.0, 1e9));
     cmd->add_option("--exposure", o.exposure, "PNG exposure in stops")
         ->capture_default_str()
-        ->check(kFinite)
+        ->check(kFiniteFloat)
         ->check(CLI::Range(-64.0f, 64.0f));
     cmd->add_flag("--quiet", o.quiet, "no progress output");
     return cmd;
@@ -304,9 +350,12 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     control.time_limit = o.time_limit;
     control.interrupted = &g_interrupted;
     control.launching = [&] {
-        report_to_supervisor("launch " + std::to_string(o.time_limit) + (o.quiet ? " 0" : " 1"));
+        // Every digit: std::to_string's six decimals would make a limit below 5e-7 s "0", none.
+        char limit[32];
+        std::snprintf(limit, sizeof limit, "%.17g", o.time_limit);
+        report_to_supervisor(std::string("launch ") + limit + (o.quiet ? " 0" : " 1"));
     };
-    InterruptGuard interrupt_guard;  // SIGINT / SIGTERM: stop and write what is done
+    InterruptGuard interrupt_guard;  // SIGINT / SIGTERM / SIGHUP: stop and write what is done
     ProgressBar bar(!o.quiet, uint64_t(o.width) * o.height);
     const double seconds_to_render =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -356,7 +405,7 @@ int render_in_job(const RenderOptions& o) {
     if (job_rank() > 0) {
         if (!o.estimator_file.empty()) report_to_supervisor("estimator " + o.estimator_file);
         report_to_supervisor("serve");  // rank 0 decides when this rank stops
-        return serve_render(render_request(o), o.devices);
+        return serve_render([&] { return render_request(o); }, o.devices);
     }
     // Every rank exits with rank 0's status; its error line is printed by run_cli alone.
     RenderJob job;

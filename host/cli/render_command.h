@@ -36,6 +36,12 @@ struct RenderOptions {
     bool quiet = false;
 };
 
+// Every option of `render` but --device (which names each machine's own devices), as this
+// process read it: "the scene S", "--width 64", "no --png", "--quiet"; one entry per option,
+// always in the same order. Under MPI every rank's must equal rank 0's (agree_on_command,
+// host/mpi/job.h).
+std::vector<std::string> render_option_words(const RenderOptions& o);
+
 // Adds the `render` subcommand, its options filling `o`.
 CLI::App* add_render_command(CLI::App& app, RenderOptions& o);
 

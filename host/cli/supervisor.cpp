@@ -19,6 +19,7 @@
 
 #include "common/environment.h"
 #include "common/signal_name.h"
+#include "common/stop_signals.h"
 
 extern char** environ;
 
@@ -48,14 +49,17 @@ bool g_terminal_stop_caught = false;
 // Only so that a child's exit interrupts poll(2) at once.
 extern "C" void on_child(int) {}
 
+// Set when this process is continued after a stop (SIGSTOP from outside, a batch system
+// suspending the job, Ctrl-Z): the time it was stopped does not count against the grace periods.
+volatile std::sig_atomic_t g_continued = 0;
+extern "C" void on_continue(int) { g_continued = 1; }
+
 void catch_terminal_stop() {
     struct sigaction action {};
     action.sa_handler = on_terminal_stop;
     sigemptyset(&action.sa_mask);
     sigaction(SIGTSTP, &action, nullptr);
 }
-
-const int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
 
 // The stop signals whose handler the supervisor installed (not those it found ignored).
 bool g_caught[NSIG] = {};
@@ -85,6 +89,10 @@ void catch_stop_signals() {
     child.sa_flags = SA_NOCLDSTOP;
     sigemptyset(&child.sa_mask);
     sigaction(SIGCHLD, &child, nullptr);
+    struct sigaction resumed {};
+    resumed.sa_handler = on_continue;
+    sigemptyset(&resumed.sa_mask);
+    sigaction(SIGCONT, &resumed, nullptr);
 }
 
 // The caught stop signals to `action` (SIG_DFL: the next one ends the supervisor, and with it
@@ -99,6 +107,7 @@ enum class Stage { kSetup, kLaunch, kServe, kWriting, kDone };
 
 // What the worker last said.
 struct WorkerStage {
+    std::string command;  // render, devices, bench or integrate
     Stage stage = Stage::kSetup;
     double time_limit = 0;
     bool bar = false;
@@ -172,6 +181,9 @@ std::string stuck_where(const WorkerStage& w, const std::string& of_what) {
         return "a launch on the devices did not return within " + grace +
                estimator_hint(w, "an estimator that does not return?",
                               "a kernel or an OpenCL driver that does not return");
+    if (w.command != "render")  // devices, bench, integrate: no stage reported
+        return "mcrt " + w.command + " did not stop within " + grace +
+               " (an OpenCL driver or kernel that does not return?)";
     return "the render did not stop within " + grace +
            " while setting up (loading the scene, building kernels, waiting for other ranks)";
 }
@@ -193,6 +205,16 @@ void kill_and_reap(pid_t pid, int* status) {
     }
 }
 
+// What a death of a command other than render was: it lists the OpenCL platforms, and bench and
+// integrate build and run kernels, in the worker, where a crashing ICD loader or driver (a broken
+// .icd file, a driver setting it cannot take) ends the process with no word of its own.
+std::string command_death(const WorkerStage& w, const std::string& how) {
+    return "mcrt " + w.command + " " + how +
+           " in the OpenCL driver, its ICD loader or mcrt (check the .icd files that "
+           "OCL_ICD_VENDORS or /etc/OpenCL/vendors name, and the driver's environment variables "
+           "such as POCL_*; `MCRT_NO_SUPERVISOR=1` runs it in one process for a debugger)";
+}
+
 // How the supervisor ends once the worker has: with its status, or one line for its death.
 int outcome(int status, const WorkerStage& w) {
     if (WIFEXITED(status)) return WEXITSTATUS(status);
@@ -204,6 +226,11 @@ int outcome(int status, const WorkerStage& w) {
         std::signal(sig, SIG_DFL);
         std::raise(sig);
         return 128 + sig;
+    }
+    if (w.command != "render") {
+        print_error(w, command_death(w, sig == SIGKILL ? "was killed (SIGKILL: out of memory?)"
+                                                       : "died of " + signal_name(sig)));
+        return 1;
     }
     if (w.stage == Stage::kDone) {
         std::cerr << "mcrt: warning: "
@@ -222,13 +249,25 @@ int outcome(int status, const WorkerStage& w) {
 }
 
 // Waits for the worker, forwarding stop signals and holding it to them and to its time limit.
-int supervise(pid_t pid, int fd) {
+int supervise(const std::string& command, pid_t pid, int fd) {
     WorkerStage w;
+    w.command = command;
     std::string pending;
     int forwarded = 0;
     Clock::time_point forwarded_at;
     auto seconds_since = [](Clock::time_point t) {
         return std::chrono::duration<double>(Clock::now() - t).count();
+    };
+    // Time stopped (this process or the worker: SIGSTOP, a suspended job, Ctrl-Z) moves the
+    // grace periods' starts on; a stopped worker is not stuck in a launch. The time limit itself
+    // is wall-clock time: the worker, continued after it, ends at its next check with what is
+    // done (ROBUSTNESS.md "Kernels that hang or crash").
+    Clock::time_point last_tick = Clock::now();
+    bool worker_stopped = false;
+    Clock::time_point worker_stopped_at;
+    auto pause_for = [&](Clock::duration paused) {
+        forwarded_at += paused;
+        w.launched += paused;
     };
     for (;;) {
         struct pollfd p = {fd, POLLIN, 0};
@@ -236,9 +275,20 @@ int supervise(pid_t pid, int fd) {
             ::close(fd);
             fd = -1;  // at its end: poll(2) ignores a negative descriptor
         }
+        const Clock::time_point now = Clock::now();
+        if (g_continued) {  // this process was stopped since the last tick
+            g_continued = 0;
+            pause_for(now - last_tick);
+        }
+        last_tick = now;
         int status = 0;
-        const pid_t done = ::waitpid(pid, &status, WNOHANG);
-        if (done == pid) {
+        const pid_t done = ::waitpid(pid, &status, WNOHANG | WUNTRACED | WCONTINUED);
+        if (done == pid && WIFSTOPPED(status)) {
+            if (!worker_stopped) worker_stopped = true, worker_stopped_at = now;
+        } else if (done == pid && WIFCONTINUED(status)) {
+            if (worker_stopped) pause_for(now - worker_stopped_at);
+            worker_stopped = false;
+        } else if (done == pid) {
             if (fd >= 0) read_reports(fd, pending, w);
             return outcome(status, w);
         }
@@ -251,8 +301,13 @@ int supervise(pid_t pid, int fd) {
                 // Ignored, as the worker ignores it.
             } else if (forwarded == 0) {
                 ::kill(pid, sig);  // its interrupt guard stops the render and writes what is done
+                if (worker_stopped) {  // a stopped worker cannot stop: it goes on to do so
+                    ::kill(pid, SIGCONT);
+                    pause_for(now - worker_stopped_at);
+                    worker_stopped = false;
+                }
                 forwarded = sig;
-                forwarded_at = Clock::now();
+                forwarded_at = now;
                 set_stop_signals(SIG_DFL);  // a second signal ends both at once
             } else {
                 // A second one that came before the handlers were reset.
@@ -264,9 +319,8 @@ int supervise(pid_t pid, int fd) {
         }
         if (g_terminal_stop) {
             // Ctrl-Z: the worker stops with this process and goes on with it (POSIX job
-            // control); the time it was stopped does not count against the grace periods.
+            // control); the time it was stopped does not count (g_continued, above).
             g_terminal_stop = 0;
-            const Clock::time_point stopped = Clock::now();
             ::kill(pid, SIGSTOP);
             // SIGSTOP, not SIGTSTP: in an orphaned process group (a child of a test runner, a
             // daemon) the kernel discards SIGTSTP's default stop (POSIX job control), which
@@ -274,15 +328,15 @@ int supervise(pid_t pid, int fd) {
             // (fg, bg, SIGCONT); a shell sees the same stopped job either way.
             std::raise(SIGSTOP);
             ::kill(pid, SIGCONT);
-            const Clock::duration paused = Clock::now() - stopped;
-            forwarded_at += paused;
-            w.launched += paused;
+            continue;
         }
+        if (worker_stopped) continue;  // stopped from outside: nothing runs that could be stuck
         if (forwarded != 0 && w.stage != Stage::kWriting && w.stage != Stage::kDone &&
             seconds_since(forwarded_at) > kSupervisorGraceSeconds) {
             kill_and_reap(pid, &status);
-            print_error(w, "stopped by " + signal_abbreviation(forwarded) + ", but " +
-                               stuck_where(w, "") + "; no image was written");
+            print_error(
+                w, "stopped by " + signal_abbreviation(forwarded) + ", but " + stuck_where(w, "") +
+                       (w.command == "render" ? "; no image was written" : "; it was killed"));
             return 1;
         }
         if (w.stage == Stage::kLaunch && w.time_limit > 0 &&
@@ -293,6 +347,15 @@ int supervise(pid_t pid, int fd) {
             return 1;
         }
     }
+}
+
+// The commands that touch OpenCL, each run in a supervised worker: render (kernels that hang or
+// crash), and devices, bench and integrate (an ICD loader or driver that crashes while listing
+// the platforms or building and running their kernels).
+bool is_supervised_command(const char* name) {
+    for (const char* command : {"render", "devices", "bench", "integrate"})
+        if (std::strcmp(name, command) == 0) return true;
+    return false;
 }
 
 // The worker's side: ends with its supervisor, and reports on the pipe it was given.
@@ -327,12 +390,12 @@ void report_to_supervisor(const std::string& line) {
     (void)ignored;
 }
 
-std::optional<int> supervise_render(int argc, char** argv) {
+std::optional<int> supervise_command(int argc, char** argv) {
     if (const char* supervised = environment(kEnvSupervised)) {
         become_worker(supervised);
         return std::nullopt;
     }
-    if (argc < 2 || std::strcmp(argv[1], "render") != 0) return std::nullopt;
+    if (argc < 2 || !is_supervised_command(argv[1])) return std::nullopt;
     const std::string opt_out = environment_value(kEnvNoSupervisor);
     if (environment(kEnvNoSupervisor) && opt_out != "0") return std::nullopt;
     std::error_code ec;
@@ -340,6 +403,19 @@ std::optional<int> supervise_render(int argc, char** argv) {
 
     int fds[2];
     if (::pipe2(fds, O_CLOEXEC) != 0) return std::nullopt;
+    // Above the standard descriptors: with stdout closed (`mcrt devices >&-`) the pipe would
+    // otherwise become the worker's stdout, and what it prints would go to this process.
+    for (int& end : fds)
+        if (end <= STDERR_FILENO) {
+            const int moved = ::fcntl(end, F_DUPFD_CLOEXEC, STDERR_FILENO + 1);
+            ::close(end);
+            end = moved;
+        }
+    if (fds[0] < 0 || fds[1] < 0) {
+        for (int end : fds)
+            if (end >= 0) ::close(end);
+        return std::nullopt;
+    }
     ::fcntl(fds[0], F_SETFL, O_NONBLOCK);
     ::fcntl(fds[1], F_SETFD, 0);  // the worker's end stays open across exec
 
@@ -378,11 +454,12 @@ std::optional<int> supervise_render(int argc, char** argv) {
         for (int sig : kStopSignals)
             if (g_caught[sig]) std::signal(sig, SIG_DFL), g_caught[sig] = false;
         std::signal(SIGCHLD, SIG_DFL);
+        std::signal(SIGCONT, SIG_DFL);
         if (g_terminal_stop_caught) std::signal(SIGTSTP, SIG_DFL);
         if (const int sig = g_signal; sig != 0) std::raise(sig);
         return std::nullopt;
     }
-    return supervise(pid, fds[0]);
+    return supervise(argv[1], pid, fds[0]);
 }
 
 }  // namespace mcrt

@@ -36,6 +36,8 @@ const std::vector<EnvironmentEntry> kEnvironment = {
      "device D computes every sample 1 + 2^-20 too large (the agreement check's test)"},
     {kEnvTestCompilerCrash, "MCRT_TEST_COMPILER_CRASH", "test hook",
      "device D's child build dies of SIGSEGV, as a vendor's compiler can"},
+    {kEnvTestContextFailure, "MCRT_TEST_CONTEXT_FAILURE", "test hook",
+     "device D's context is refused (CL_DEVICE_NOT_AVAILABLE), as a driver can refuse one"},
     {kEnvFaultInject, "MCRT_FAULT_INJECT", "test hook",
      "D:N: device D fails at its N-th launch (a device lost mid-render)"},
     {kEnvSlowDevice, "MCRT_SLOW_DEVICE", "test hook",

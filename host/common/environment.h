@@ -26,6 +26,7 @@ enum EnvironmentVariable {
     kEnvTestNoTmpfile,    // MCRT_TEST_NO_TMPFILE
     kEnvTestWrongDevice,  // MCRT_TEST_WRONG_DEVICE
     kEnvTestCompilerCrash,  // MCRT_TEST_COMPILER_CRASH
+    kEnvTestContextFailure, // MCRT_TEST_CONTEXT_FAILURE
     kEnvFaultInject,      // MCRT_FAULT_INJECT
     kEnvSlowDevice,       // MCRT_SLOW_DEVICE
     // Set by others, read by mcrt.

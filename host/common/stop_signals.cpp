@@ -1,22 +1,27 @@
 #include "common/stop_signals.h"
 
-#include <csignal>
-
 namespace mcrt {
 
 namespace {
 volatile std::sig_atomic_t g_outputs_complete = 0;
 const volatile std::sig_atomic_t* g_stop_flag = nullptr;
+
+// Read during static initialisation, before main and before any OpenCL library is loaded.
+const bool g_hangup_ignored = [] {
+    struct sigaction action {};
+    return sigaction(SIGHUP, nullptr, &action) == 0 && action.sa_handler == SIG_IGN;
+}();
 }  // namespace
 
 void set_stop_flag(const volatile std::sig_atomic_t* flag) { g_stop_flag = flag; }
 
 bool stop_requested() { return g_stop_flag != nullptr && *g_stop_flag != 0; }
 
+bool ignored_at_start(int sig) { return sig == SIGHUP && g_hangup_ignored; }
+
 void outputs_complete() {
     g_outputs_complete = 1;
-    std::signal(SIGINT, SIG_IGN);
-    std::signal(SIGTERM, SIG_IGN);
+    for (int sig : kStopSignals) std::signal(sig, SIG_IGN);
 }
 
 bool outputs_are_complete() { return g_outputs_complete != 0; }

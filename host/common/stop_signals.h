@@ -1,10 +1,14 @@
-// After every output is complete a stop signal has nothing left to save: SIGINT and SIGTERM are
-// ignored from then on, so the process still exits 0 (ROBUSTNESS.md "Signals and pipes").
+// The signals that ask a render to stop, and what becomes of them once its outputs are complete
+// (ROBUSTNESS.md "Signals and pipes").
 #pragma once
 
 #include <csignal>
 
 namespace mcrt {
+
+// SIGINT (Ctrl-C), SIGTERM (kill, a batch system's end of a job) and SIGHUP (a closed terminal or
+// ssh session): each stops a render, which writes the samples done so far.
+inline constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
 
 // The flag a stop signal raises while a render runs (the render's interrupt guard sets it), or
 // nullptr: work that blocks outside the render loop (the output commit's wait for another
@@ -12,12 +16,18 @@ namespace mcrt {
 void set_stop_flag(const volatile std::sig_atomic_t* flag);
 bool stop_requested();
 
-// Ignores SIGINT and SIGTERM for the rest of the process.
+// After every output is complete a stop signal has nothing left to save: the stop signals are
+// ignored for the rest of the process, so it still exits 0.
 void outputs_complete();
 
 // True once outputs_complete() ran: the render's interrupt guard must not restore the default
 // (terminating) actions then.
 bool outputs_are_complete();
+
+// True when `sig` was ignored when the process started (SIGHUP under nohup), read before any
+// library could install a handler over it (LLVM, inside an OpenCL compiler, catches SIGHUP, SIGINT
+// and SIGTERM, and would hide that they were ignored).
+bool ignored_at_start(int sig);
 
 // SIGPIPE ignored (a closed stderr pipe makes writes fail, harmlessly, instead of killing the
 // process before the image is written); SIGXFSZ too, so a file-size limit is a write error.

@@ -41,6 +41,8 @@ bool test_wrong_device(int device) { return names_device(kEnvTestWrongDevice, de
 
 bool test_compiler_crash(int device) { return names_device(kEnvTestCompilerCrash, device); }
 
+bool test_context_failure(int device) { return names_device(kEnvTestContextFailure, device); }
+
 uint64_t test_fault_launch(int device) {
     double launch = 0;
     return environment_device_value(kEnvFaultInject, device, &launch) ? uint64_t(launch) : 0;

@@ -28,6 +28,10 @@ bool test_wrong_device(int device);
 // (host/cl/build_child.h) dies of SIGSEGV, as Intel's compiler did.
 bool test_compiler_crash(int device);
 
+// True when MCRT_TEST_CONTEXT_FAILURE names device index `device`: its context is refused as
+// Intel's runtime refuses one with CL_CONFIG_CPU_TARGET_ARCH=junk (CL_DEVICE_NOT_AVAILABLE).
+bool test_context_failure(int device);
+
 // The launch (counted from 1) at which device `device` fails, when MCRT_FAULT_INJECT is "D:N"
 // for it; 0: never.
 uint64_t test_fault_launch(int device);

@@ -8,17 +8,20 @@
 #include <mpi.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <string>
 #include <thread>
 
 #include "bvh/bvh.h"
 #include "cl/device_select.h"
 #include "common/environment.h"
 #include "common/error.h"
+#include "common/stop_signals.h"
 #include "mpi/job.h"
 #include "mpi/mpi_comm.h"
 #include "mpi/remote_worker.h"
@@ -67,6 +70,87 @@ JobSession::~JobSession() {
 
 int job_rank() { return g_rank; }
 int job_size() { return g_size; }
+
+namespace {
+
+// A rank's reading of its command line on the wire: the usage error (empty when none), then each
+// entry, each followed by a NUL (command-line arguments hold none).
+std::string encode_command(const std::vector<std::string>& command, const std::string& refused) {
+    std::string bytes = refused + '\0';
+    for (const std::string& entry : command) bytes += entry + '\0';
+    return bytes;
+}
+
+std::vector<std::string> decode_command(const std::string& bytes, std::string& refused) {
+    std::vector<std::string> parts;
+    for (size_t at = 0; at < bytes.size();) {
+        const size_t end = bytes.find('\0', at);
+        parts.push_back(bytes.substr(at, end == std::string::npos ? std::string::npos : end - at));
+        at = end == std::string::npos ? bytes.size() : end + 1;
+    }
+    refused = parts.empty() ? "" : parts.front();
+    if (!parts.empty()) parts.erase(parts.begin());
+    return parts;
+}
+
+// Why rank `rank`'s reading (`command`, `refused`) is not rank 0's (`root`); "" when it is.
+std::string disagreement(int rank, const std::vector<std::string>& command,
+                         const std::string& refused, const std::vector<std::string>& root) {
+    const std::string who = "rank " + std::to_string(rank);
+    if (!refused.empty())
+        return who + " refused its command line: " + refused +
+               " (every rank must be given rank 0's options)";
+    if (command.empty() || root.empty() || command.front() != root.front())
+        return who + " runs " + (command.empty() ? "another command" : command.front()) +
+               ", rank 0 " + (root.empty() ? "another" : root.front()) +
+               ": every rank of a job runs rank 0's command";
+    for (size_t i = 1; i < std::max(command.size(), root.size()); ++i) {
+        const std::string mine = i < command.size() ? command[i] : "nothing more";
+        const std::string its = i < root.size() ? root[i] : "nothing more";
+        if (mine != its)
+            return who + " was started with " + mine + ", rank 0 with " + its +
+                   ": every rank renders with rank 0's options (only --device may differ)";
+    }
+    return "";
+}
+
+}  // namespace
+
+int agree_on_command(const std::vector<std::string>& command, const std::string& refused) {
+    if (!g_joined || g_size < 2) return 0;
+    const std::string mine = encode_command(command, refused);
+    // Gathered as bytes; MPI counts are int, and a command line is far below 2 GiB.
+    const int length = int(std::min<size_t>(mine.size(), size_t(1) << 30));
+    std::vector<int> lengths(size_t(g_rank == 0 ? g_size : 0));
+    MPI_Gather(&length, 1, MPI_INT, lengths.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
+    std::vector<int> offsets(lengths.size());
+    std::string all;
+    if (g_rank == 0) {
+        size_t total = 0;
+        for (size_t r = 0; r < lengths.size(); ++r) {
+            offsets[r] = int(total);
+            total += size_t(lengths[r]);
+        }
+        all.resize(total);
+    }
+    MPI_Gatherv(mine.data(), length, MPI_CHAR, all.data(), lengths.data(), offsets.data(), MPI_CHAR,
+                0, MPI_COMM_WORLD);
+    uint64_t status = 0;
+    if (g_rank == 0) {
+        if (!refused.empty()) status = 2;  // rank 0's caller prints its own usage error
+        for (int r = 1; r < g_size && status == 0; ++r) {
+            std::string its_refusal;
+            const std::vector<std::string> its = decode_command(
+                all.substr(size_t(offsets[size_t(r)]), size_t(lengths[size_t(r)])), its_refusal);
+            const std::string why = disagreement(r, its, its_refusal, command);
+            if (why.empty()) continue;
+            std::fprintf(stderr, "mcrt: error: %s\n", why.c_str());
+            std::fflush(stderr);
+            status = 2;
+        }
+    }
+    return int(mpi::broadcast_u64(status, 0));
+}
 
 // ---------------------------------------------------------------------------------------------
 // Rank 0
@@ -225,12 +309,12 @@ void serve_device(RenderWorker& worker, int slot) {
 
 }  // namespace
 
-int serve_render(const RenderRequest& request, const std::vector<std::string>& device_names) {
+int serve_render(const std::function<RenderRequest()>& make_request,
+                 const std::vector<std::string>& device_names) {
     // Rank 0 decides when the render stops (its signals, its time limit) and tells every rank;
-    // mpirun's SIGTERM to all ranks at Ctrl-C must not end this one before rank 0 has the
-    // samples it is rendering.
-    std::signal(SIGINT, SIG_IGN);
-    std::signal(SIGTERM, SIG_IGN);
+    // mpirun's SIGTERM to all ranks at Ctrl-C (or a SIGHUP) must not end this one before rank 0 has
+    // the samples it is rendering.
+    for (int sig : kStopSignals) std::signal(sig, SIG_IGN);
 
     const uint64_t go = mpi::broadcast_u64(0, 0);
     if (go != 0) return int(go);
@@ -245,7 +329,7 @@ int serve_render(const RenderRequest& request, const std::vector<std::string>& d
     std::vector<std::unique_ptr<DeviceWorker>> workers;
     try {
         FileBundle files;
-        RenderRequest r = request;
+        RenderRequest r = make_request();  // rank 0 made the same one: it said go
         wire::decode_inputs(bytes, files, r.settings.estimator_source);
         bytes = {};
         SceneSource source;

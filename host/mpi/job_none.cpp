@@ -10,6 +10,7 @@ JobSession::JobSession() = default;
 JobSession::~JobSession() = default;
 int job_rank() { return 0; }
 int job_size() { return 1; }
+int agree_on_command(const std::vector<std::string>&, const std::string&) { return 0; }
 
 RenderJob::RenderJob() { throw RuntimeError("mcrt was built without MPI"); }
 RenderJob::~RenderJob() = default;
@@ -17,6 +18,6 @@ void RenderJob::share_inputs(const FileBundle&, const std::string&) {}
 RemoteWorkers RenderJob::remote_workers(std::function<void(const std::string&)>) { return {}; }
 nlohmann::json RenderJob::ranks_json(const std::vector<DeviceReport>&) const { return {}; }
 void RenderJob::finish(int, const std::string&) {}
-int serve_render(const RenderRequest&, const std::vector<std::string>&) { throw RuntimeError("mcrt was built without MPI"); }
+int serve_render(const std::function<RenderRequest()>&, const std::vector<std::string>&) { throw RuntimeError("mcrt was built without MPI"); }
 
 }  // namespace mcrt
