@@ -135,12 +135,14 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
     data.packets = bvh.packets;
     for (const Material& m : scene.materials) {
         gpu::Material g{};
-        // KHR_materials_specular: the dielectric's F0 = min(0.04 specularColor, 1) × specular
-        // and F90 = specular; GGX α = roughness², at least MCRT_ALPHA_MIN.
+        // KHR_materials_specular with KHR_materials_ior: the dielectric's F0 = min(f0(ior) ×
+        // specularColor, 1) × specular and F90 = specular; GGX α = roughness², at least
+        // MCRT_ALPHA_MIN.
         const float alpha = std::max(m.roughness * m.roughness, MCRT_ALPHA_MIN);
         g.base_color = to_float4(m.albedo, 1.0f);
         g.emission = to_float4(m.emission);
-        g.specular = to_float4(glm::min(0.04f * m.specular_color, glm::vec3(1.0f)) * m.specular,
+        g.specular = to_float4(glm::min(dielectric_f0(m.ior) * m.specular_color, glm::vec3(1.0f)) *
+                                   m.specular,
                                m.specular);
         g.metallic = m.metallic;
         g.alpha = alpha;

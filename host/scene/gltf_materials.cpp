@@ -1,6 +1,6 @@
 // glTF materials as mcrt's Material: the metallic-roughness factors (glTF 2.0 Appendix B),
-// emission with KHR_materials_emissive_strength, KHR_materials_specular, the alpha mode and the
-// texture slots (gltf_textures.cpp); what is ignored warned.
+// emission with KHR_materials_emissive_strength, KHR_materials_specular, KHR_materials_ior, the
+// alpha mode and the texture slots (gltf_textures.cpp); what is ignored warned.
 #include "scene/gltf_materials.h"
 
 #include <algorithm>
@@ -34,7 +34,7 @@ float unit_factor(double value, const char* what, const std::string& element, Di
 
 // glTF 2.0 Appendix B's parameters: metallicFactor, roughnessFactor (default 1 each), and
 // KHR_materials_specular's specularFactor (default 1) and specularColorFactor (default 1, 1, 1;
-// F0 = min(0.04 × it, 1) is clamped where the BRDF is built, host/render/gpu_scene.cpp).
+// F0 = min(f0(ior) × it, 1) is clamped where the BRDF is built, host/render/gpu_scene.cpp).
 void read_microfacet_factors(const tinygltf::Material& source, const std::string& element,
                              Diagnostics& diag, Material& material) {
     const auto& pbr = source.pbrMetallicRoughness;
@@ -67,6 +67,40 @@ void read_microfacet_factors(const tinygltf::Material& source, const std::string
         }
         material.specular_color = glm::vec3(c);
     }
+}
+
+// A number of an extension object, or NaN where it is there but not a number (refused by the
+// caller's finiteness check); `fallback` where it is absent.
+double extension_number(const tinygltf::Value& ext, const char* name, double fallback) {
+    if (!ext.Has(name)) return fallback;
+    const tinygltf::Value& v = ext.Get(name);
+    return v.IsNumber() ? v.GetNumberAsDouble() : std::numeric_limits<double>::quiet_NaN();
+}
+
+// The largest index of refraction read as given; beyond it (F0 > 0.9996) the value is clamped,
+// so that ior² stays far from float's range in the kernels.
+constexpr double kMaxIor = 1e4;
+
+// KHR_materials_ior: `ior` ≥ 1, or exactly 0 (the extension's specular-glossiness mode, where
+// the Fresnel term is 1); default 1.5. Not a finite number: refused. Below 1 (but not 0): the
+// default with one warning. Above kMaxIor: clamped with one warning.
+void read_ior(const tinygltf::Material& source, const std::string& element, Diagnostics& diag,
+              Material& material) {
+    material.ior = 1.5f;
+    const auto extension = source.extensions.find("KHR_materials_ior");
+    if (extension == source.extensions.end() || !extension->second.IsObject()) return;
+    double ior = extension_number(extension->second, "ior", 1.5);
+    if (!std::isfinite(ior)) diag.fail(element, "KHR_materials_ior.ior must be a finite number");
+    if (ior != 0.0 && ior < 1.0) {
+        diag.warn_once("ior-range", element + ": KHR_materials_ior.ior " + format_number(ior) +
+                                        " is neither 0 nor at least 1; the default 1.5 is used");
+        ior = 1.5;
+    } else if (ior > kMaxIor) {
+        diag.warn_once("ior-large", element + ": KHR_materials_ior.ior " + format_number(ior) +
+                                        " is above " + format_number(kMaxIor) + "; clamped");
+        ior = kMaxIor;
+    }
+    material.ior = float(ior);
 }
 
 // KHR_materials_emissive_strength: a non-negative multiplier of emissiveFactor, 1 when absent.
@@ -214,6 +248,7 @@ Material MaterialTable::convert(int material_index, const std::string& referrer)
     }
     material.double_sided = source.doubleSided;
     read_microfacet_factors(source, element, diag_, material);
+    read_ior(source, element, diag_, material);
     read_alpha(source, element, diag_, material);
     read_texture_slots(source, element, textures_, diag_, material);
     return material;

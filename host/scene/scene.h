@@ -53,6 +53,9 @@ struct Material {
     float roughness = 1.0f;    // roughnessFactor, [0, 1]; GGX α = roughness²
     float specular = 0.0f;     // KHR_materials_specular.specularFactor, [0, 1]; glTF default 1
     glm::vec3 specular_color{1.0f};  // KHR_materials_specular.specularColorFactor, ≥ 0
+    // KHR_materials_ior: the dielectric's F0 = ((ior − 1)/(ior + 1))², 0.04 at the default 1.5;
+    // ior is ≥ 1, or exactly 0, the extension's specular-glossiness mode (F = 1 everywhere).
+    float ior = 1.5f;
     float alpha = 1.0f;        // baseColorFactor.a, [0, 1]
     AlphaMode alpha_mode = AlphaMode::Opaque;
     float alpha_cutoff = 0.5f; // MASK only
@@ -74,6 +77,13 @@ struct Material {
     // Exactly the Lambertian albedo/π: no metal, and no specular layer on the dielectric.
     bool lambertian() const { return metallic == 0.0f && specular == 0.0f; }
 };
+
+// KHR_materials_ior's dielectric F0 = ((ior − 1)/(ior + 1))², in double and rounded once: exactly
+// 0.04f at the default ior 1.5, 1 at ior 0 (the extension's specular-glossiness mode).
+inline float dielectric_f0(float ior) {
+    const double r = (double(ior) - 1.0) / (double(ior) + 1.0);
+    return float(r * r);
+}
 
 // `--materials lambert`: every surface the course's Lambertian reflector of its baseColor.
 void make_lambertian(std::vector<Material>& materials);
