@@ -148,12 +148,20 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
         g.alpha = alpha;
         g.type = m.lambertian() ? MATERIAL_LAMBERTIAN : MATERIAL_METALLIC_ROUGHNESS;
         g.flags = m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u;
+        // KHR_materials_transmission, _ior, _volume (kernels/bsdf.cl, dielectric.cl).
+        g.transmission = m.transmission;
+        g.ior = m.ior;
+        if (m.transmission > 0.0f && m.volume) {
+            g.flags |= MATERIAL_VOLUME;
+            g.attenuation = to_float4(glm::vec3(volume_attenuation(m)));
+        }
         const bool slots = m.base_color_texture.used() || m.metallic_roughness_texture.used() ||
                            m.normal_texture.used() || m.emissive_texture.used();
         if (slots) g.flags |= MATERIAL_TEXTURED;
         if (m.alpha_mode != AlphaMode::Opaque) g.flags |= MATERIAL_ALPHA_TESTED;
         data.materials.push_back(g);
         data.microfacet = data.microfacet || g.type != MATERIAL_LAMBERTIAN;
+        data.transmission = data.transmission || m.transmission > 0.0f;
         data.textured = data.textured || m.textured();
     }
     if (data.materials.empty()) data.materials.push_back(gpu::Material{});

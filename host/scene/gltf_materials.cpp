@@ -1,6 +1,6 @@
 // glTF materials as mcrt's Material: the metallic-roughness factors (glTF 2.0 Appendix B),
-// emission with KHR_materials_emissive_strength, KHR_materials_specular, KHR_materials_ior, the
-// alpha mode and the texture slots (gltf_textures.cpp); what is ignored warned.
+// emission with KHR_materials_emissive_strength, KHR_materials_specular, KHR_materials_ior,
+// KHR_materials_transmission and KHR_materials_volume, the alpha mode and the texture slots (gltf_textures.cpp); what is ignored warned.
 #include "scene/gltf_materials.h"
 
 #include <algorithm>
@@ -103,6 +103,64 @@ void read_ior(const tinygltf::Material& source, const std::string& element, Diag
     material.ior = float(ior);
 }
 
+// The extension object `name` of a material, or null where it is absent (or not an object).
+const tinygltf::Value* extension_object(const tinygltf::Material& source, const char* name) {
+    const auto extension = source.extensions.find(name);
+    if (extension == source.extensions.end() || !extension->second.IsObject()) return nullptr;
+    return &extension->second;
+}
+
+// KHR_materials_transmission: transmissionFactor in [0, 1] (default 0). Its texture is not
+// read: the factor holds over the whole surface (one warning).
+// KHR_materials_volume (only with transmission): thicknessFactor ≥ 0 (default 0, thin-walled);
+// > 0 makes the surface bound a volume (thicknessTexture only matters to rasterizers that
+// fake refraction, and is not read); attenuationColor in [0, 1]³ (default white), clamped with
+// one warning; attenuationDistance > 0 (default ∞): 0 or negative is read as ∞, with one warning.
+void read_transmission(const tinygltf::Material& source, const std::string& element,
+                       Diagnostics& diag, Material& material) {
+    const tinygltf::Value* ext = extension_object(source, "KHR_materials_transmission");
+    if (!ext) return;
+    material.transmission =
+        unit_factor(extension_number(*ext, "transmissionFactor", 0.0),
+                    "KHR_materials_transmission.transmissionFactor", element, diag);
+    if (ext->Has("transmissionTexture")) {
+        diag.warn_once("transmission-texture",
+                       element + ": KHR_materials_transmission.transmissionTexture is not "
+                                 "read; transmissionFactor holds over the whole surface");
+    }
+    const tinygltf::Value* volume = extension_object(source, "KHR_materials_volume");
+    if (!volume || material.transmission == 0.0f) return;
+    const double thickness = extension_number(*volume, "thicknessFactor", 0.0);
+    if (!std::isfinite(thickness) || thickness < 0.0) {
+        diag.fail(element, "KHR_materials_volume.thicknessFactor must be a finite number >= 0");
+    }
+    material.volume = thickness > 0.0;
+    double distance = extension_number(*volume, "attenuationDistance",
+                                       std::numeric_limits<double>::infinity());
+    if (std::isnan(distance)) {
+        diag.fail(element, "KHR_materials_volume.attenuationDistance must be a number > 0");
+    }
+    if (!(distance > 0.0)) {
+        diag.warn_once("attenuation-distance",
+                       element + ": KHR_materials_volume.attenuationDistance " +
+                           format_number(distance) + " is not above 0; no attenuation");
+        distance = std::numeric_limits<double>::infinity();
+    }
+    material.attenuation_distance = float(distance);  // beyond float's range: ∞, no loss
+    if (volume->Has("attenuationColor")) {
+        const tinygltf::Value& v = volume->Get("attenuationColor");
+        if (!v.IsArray() || v.ArrayLen() != 3) {
+            diag.fail(element, "KHR_materials_volume.attenuationColor must be 3 numbers");
+        }
+        for (int k = 0; k < 3; ++k) {
+            const tinygltf::Value& c = v.Get(k);
+            material.attenuation_color[k] = unit_factor(
+                c.IsNumber() ? c.GetNumberAsDouble() : std::numeric_limits<double>::quiet_NaN(),
+                "KHR_materials_volume.attenuationColor", element, diag);
+        }
+    }
+}
+
 // KHR_materials_emissive_strength: a non-negative multiplier of emissiveFactor, 1 when absent.
 double emissive_strength(const tinygltf::Material& material, const std::string& element,
                          const Diagnostics& diag) {
@@ -169,11 +227,6 @@ void warn_unsupported_parts(const tinygltf::Material& material, Diagnostics& dia
         // A path tracer's light transport computes the occlusion such a map approximates.
         diag.warn_once("occlusion",
                        "occlusionTexture is not used: the light transport computes occlusion");
-    }
-    if (material.extensions.count("KHR_materials_transmission")) {
-        diag.warn_once("transmission",
-                       "KHR_materials_transmission is not supported; surfaces are opaque "
-                       "(reflection only)");
     }
 }
 
@@ -249,6 +302,7 @@ Material MaterialTable::convert(int material_index, const std::string& referrer)
     material.double_sided = source.doubleSided;
     read_microfacet_factors(source, element, diag_, material);
     read_ior(source, element, diag_, material);
+    read_transmission(source, element, diag_, material);
     read_alpha(source, element, diag_, material);
     read_texture_slots(source, element, textures_, diag_, material);
     return material;
