@@ -142,6 +142,105 @@ TEST_CASE("KHR_materials_ior sets every dielectric's F0; ior 1.5 gives exactly 0
     }
 }
 
+// ---- KHR_materials_transmission and KHR_materials_volume ---------------------------------------
+
+TEST_CASE("transmission and volume are read; bad values warn once with a fallback or are refused",
+          "[glass][gltf]") {
+    SECTION("transmission alone: thin-walled, not Lambertian, built with -D MCRT_TRANSMISSION") {
+        const Loaded l = load_material(R"("KHR_materials_transmission": {"transmissionFactor": 0.75})");
+        CHECK(l.warnings.empty());
+        CHECK(l.material.transmission == 0.75f);
+        CHECK_FALSE(l.material.volume);
+        CHECK_FALSE(l.material.lambertian());
+        Scene s;
+        s.materials.push_back(l.material);
+        add_triangle(s, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 0);
+        RenderSettings settings;
+        GpuSceneData data = make_gpu_scene(s, build_bvh(s), Camera{}, 1, 1);
+        CHECK(data.transmission);
+        CHECK(data.materials[0].transmission == 0.75f);
+        CHECK((data.materials[0].flags & MATERIAL_VOLUME) == 0u);
+        CHECK(make_render_plan(settings, data).program_options.find("-D MCRT_TRANSMISSION") !=
+              std::string::npos);
+        // --materials lambert reads the same surface as opaque Lambertian: no glass code.
+        make_lambertian(s.materials);
+        GpuSceneData flat = make_gpu_scene(s, build_bvh(s), Camera{}, 1, 1);
+        CHECK_FALSE(flat.transmission);
+        CHECK(make_render_plan(settings, flat).program_options.find("MCRT_TRANSMISSION") ==
+              std::string::npos);
+    }
+    SECTION("a scene without transmission builds without the glass code") {
+        const Loaded l = load_material(R"("KHR_materials_ior": {"ior": 1.7})");
+        Scene s;
+        s.materials.push_back(l.material);
+        add_triangle(s, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 0);
+        GpuSceneData data = make_gpu_scene(s, build_bvh(s), Camera{}, 1, 1);
+        CHECK(data.microfacet);
+        CHECK_FALSE(data.transmission);
+        CHECK(make_render_plan(RenderSettings{}, data).program_options.find("MCRT_TRANSMISSION") ==
+              std::string::npos);
+    }
+    SECTION("a volume: attenuation in bits per unit length, -log2(colour)/distance") {
+        const Loaded l = load_material(R"("KHR_materials_transmission": {"transmissionFactor": 1},
+            "KHR_materials_volume": {"thicknessFactor": 0.1, "attenuationDistance": 2,
+                                     "attenuationColor": [0.5, 1, 0.25]})");
+        CHECK(l.warnings.empty());
+        REQUIRE(l.material.volume);
+        const glm::dvec3 a = volume_attenuation(l.material);
+        CHECK(a.x == Approx(0.5));
+        CHECK(a.y == 0.0);
+        CHECK(a.z == Approx(1.0));
+        Scene s;
+        s.materials.push_back(l.material);
+        add_triangle(s, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 0);
+        const gpu::Material g = make_gpu_scene(s, build_bvh(s), Camera{}, 1, 1).materials[0];
+        CHECK((g.flags & MATERIAL_VOLUME) != 0u);
+        CHECK(g.attenuation.x == Approx(0.5f));
+    }
+    SECTION("a volume without transmission, or of thickness 0, is no volume") {
+        CHECK_FALSE(load_material(R"("KHR_materials_volume": {"thicknessFactor": 1})").material.volume);
+        CHECK_FALSE(load_material(R"("KHR_materials_transmission": {"transmissionFactor": 1},
+            "KHR_materials_volume": {"thicknessFactor": 0})").material.volume);
+    }
+    SECTION("attenuationDistance <= 0: no attenuation, one warning; colour clamped; black finite") {
+        for (const char* d : {"0", "-3"}) {
+            const Loaded l = load_material(std::string(R"("KHR_materials_transmission": {"transmissionFactor": 1},
+                "KHR_materials_volume": {"thicknessFactor": 1, "attenuationDistance": )") + d + "}");
+            REQUIRE(l.warnings.size() == 1);
+            CHECK(l.warnings[0].find("attenuationDistance") != std::string::npos);
+            CHECK(volume_attenuation(l.material) == glm::dvec3(0.0));
+        }
+        const Loaded c = load_material(R"("KHR_materials_transmission": {"transmissionFactor": 1},
+            "KHR_materials_volume": {"thicknessFactor": 1, "attenuationDistance": 1,
+                                     "attenuationColor": [2, 0, 0.5]})");
+        REQUIRE(c.warnings.size() == 1);
+        CHECK(c.warnings[0].find("clamped") != std::string::npos);
+        const glm::dvec3 a = volume_attenuation(c.material);
+        CHECK(a.x == 0.0);
+        CHECK(a.y == 1e30);  // black: everything absorbed, yet 0 * a stays 0
+        CHECK(a.z == Approx(1.0));
+    }
+    SECTION("transmissionTexture is not read: one warning") {
+        const Loaded l = load_material(
+            R"("KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": {"index": 0}})");
+        REQUIRE(l.warnings.size() == 1);
+        CHECK(l.warnings[0].find("transmissionTexture") != std::string::npos);
+    }
+    SECTION("refused: non-numbers, a negative thickness, a malformed colour") {
+        CHECK(refusal(R"("KHR_materials_transmission": {"transmissionFactor": "all"})")
+                  .find("transmissionFactor must be a finite number") != std::string::npos);
+        CHECK(refusal(R"("KHR_materials_transmission": {"transmissionFactor": 1},
+            "KHR_materials_volume": {"thicknessFactor": -1})")
+                  .find("thicknessFactor must be a finite number >= 0") != std::string::npos);
+        CHECK(refusal(R"("KHR_materials_transmission": {"transmissionFactor": 1},
+            "KHR_materials_volume": {"thicknessFactor": 1, "attenuationColor": [1, 1]})")
+                  .find("attenuationColor must be 3 numbers") != std::string::npos);
+        CHECK(refusal(R"("KHR_materials_transmission": {"transmissionFactor": 1},
+            "KHR_materials_volume": {"thicknessFactor": 1, "attenuationDistance": "far"})")
+                  .find("attenuationDistance must be a number > 0") != std::string::npos);
+    }
+}
+
 // ---- The BSDF's kernels: sampling against its pdf twin, delta lobes, Fresnel -------------------
 
 namespace {
