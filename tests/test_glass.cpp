@@ -778,3 +778,65 @@ TEST_CASE("every path estimator renders the same mean through rough and smooth g
         }
     }
 }
+
+// ---- A smooth glass slab above a Lambertian floor under the sky: the closed form ----------------
+
+namespace {
+
+// The cosine-weighted hemispherical transmittance of a smooth slab of relative index eta without
+// absorption, T̄ = 2 ∫ T_s(μ) μ dμ with T_s = (1 − R)/(1 + R), the sum over the slab's internal
+// reflections of a single interface's Fresnel reflectance R (docs/MATERIALS.md, "The slab").
+double slab_transmittance(double eta) {
+    const int n = 200000;
+    double sum = 0;
+    for (int i = 0; i < n; ++i) {
+        const double mu = (i + 0.5) / n, R = fresnel_reference(mu, eta);
+        sum += 2.0 * (1.0 - R) / (1.0 + R) * mu / n;
+    }
+    return sum;
+}
+
+}  // namespace
+
+TEST_CASE("a smooth glass slab over a Lambertian floor under the sky: the floor's closed form",
+          "[glass][slab]") {
+    // Floor radiance L = ρ/π ∫ (T_s L_sky + R_s L) cosθ dω = ρ (T̄ + (1 − T̄) L) for a uniform sky of
+    // radiance 1, so L = ρ T̄ / (1 − ρ (1 − T̄)): the light the slab lets through plus what it
+    // sends back between floor and slab, every order. The slab (2000 wide, 0.1 thick, 0.5 above
+    // the floor) is infinite for the camera between them, looking down.
+    const glm::dvec3 rho(0.5, 0.7, 0.3);
+    const double T = slab_transmittance(1.5);
+    const glm::dvec3 exact = rho * T / (1.0 - rho * (1.0 - T));
+    Scene scene;
+    const float w = 1000.0f;
+    uint32_t floor = add_material(scene, glm::vec3(rho));
+    add_quad(scene, {-w, 0, -w}, {-w, 0, w}, {w, 0, w}, {w, 0, -w}, floor);
+    scene.materials.push_back(rough(0.0, true, true, "slab").scene_material());
+    const uint32_t glass = uint32_t(scene.materials.size() - 1);
+    const float y0 = 0.5f, y1 = 0.6f;
+    // The box's six faces, counter-clockwise seen from outside.
+    add_quad(scene, {-w, y1, -w}, {-w, y1, w}, {w, y1, w}, {w, y1, -w}, glass);  // top, +y
+    add_quad(scene, {-w, y0, -w}, {w, y0, -w}, {w, y0, w}, {-w, y0, w}, glass);  // bottom, −y
+    add_quad(scene, {-w, y0, w}, {w, y0, w}, {w, y1, w}, {-w, y1, w}, glass);    // +z
+    add_quad(scene, {-w, y0, -w}, {-w, y1, -w}, {w, y1, -w}, {w, y0, -w}, glass);  // −z
+    add_quad(scene, {w, y0, -w}, {w, y1, -w}, {w, y1, w}, {w, y0, w}, glass);    // +x
+    add_quad(scene, {-w, y0, -w}, {-w, y0, w}, {-w, y1, w}, {-w, y1, -w}, glass);  // −x
+    Camera camera = looking_down(glm::vec3(0.0f, 0.25f, 0.0f), glm::radians(30.0f));
+    DeviceContext device = first_device();
+    RenderSettings settings;
+    settings.width = 8;
+    settings.height = 8;
+    settings.spp = 64;
+    settings.sky = glm::vec3(1.0f);
+    settings.sky_light = true;
+    settings.max_depth = MCRT_MAX_PATH_DEPTH;
+    settings.rr_depth = MCRT_MAX_PATH_DEPTH;
+    GpuSceneData data = gpu_scene_for(scene, camera, settings);
+    for (const char* estimator : {"mis", "bsdf", "light-area"}) {
+        settings.estimator = estimator;
+        Renders r = independent_renders(device, data, settings, 10, 900);
+        check_unbiased(r, exact, std::string("slab, ") + estimator);
+        CHECK(r.non_finite_pixels == 0);
+        for (int c = 0; c < 3; ++c) CHECK(r.standard_error[c] < 0.01 * exact[c]);  // not vacuous
+    }
+}
