@@ -184,7 +184,9 @@ TEST_CASE("transmission and volume are read; bad values warn once with a fallbac
         const Loaded l = load_material(R"("KHR_materials_transmission": {"transmissionFactor": 1},
             "KHR_materials_volume": {"thicknessFactor": 0.1, "attenuationDistance": 2,
                                      "attenuationColor": [0.5, 1, 0.25]})");
-        CHECK(l.warnings.empty());
+        // One triangle bounds no volume: one warning, the render goes on.
+        REQUIRE(l.warnings.size() == 1);
+        CHECK(l.warnings[0].find("not closed (3 of its 3 edges") != std::string::npos);
         REQUIRE(l.material.volume);
         const glm::dvec3 a = volume_attenuation(l.material);
         CHECK(a.x == Approx(0.5));
@@ -206,19 +208,28 @@ TEST_CASE("transmission and volume are read; bad values warn once with a fallbac
         for (const char* d : {"0", "-3"}) {
             const Loaded l = load_material(std::string(R"("KHR_materials_transmission": {"transmissionFactor": 1},
                 "KHR_materials_volume": {"thicknessFactor": 1, "attenuationDistance": )") + d + "}");
-            REQUIRE(l.warnings.size() == 1);
+            REQUIRE(l.warnings.size() == 2);  // and the open surface's
             CHECK(l.warnings[0].find("attenuationDistance") != std::string::npos);
             CHECK(volume_attenuation(l.material) == glm::dvec3(0.0));
         }
         const Loaded c = load_material(R"("KHR_materials_transmission": {"transmissionFactor": 1},
             "KHR_materials_volume": {"thicknessFactor": 1, "attenuationDistance": 1,
                                      "attenuationColor": [2, 0, 0.5]})");
-        REQUIRE(c.warnings.size() == 1);
+        REQUIRE(c.warnings.size() == 2);  // and the open surface's
         CHECK(c.warnings[0].find("clamped") != std::string::npos);
         const glm::dvec3 a = volume_attenuation(c.material);
         CHECK(a.x == 0.0);
         CHECK(a.y == 1e30);  // black: everything absorbed, yet 0 * a stays 0
         CHECK(a.z == Approx(1.0));
+    }
+    SECTION("a closed volume loads without a warning") {
+        std::vector<std::string> warnings;
+        const Scene s = load_gltf(std::string(MCRT_SCENES) + "/glass/glass-sphere.gltf",
+                                  [&](const std::string& w) { warnings.push_back(w); });
+        CHECK(warnings.empty());
+        bool volume = false;
+        for (const Material& m : s.materials) volume = volume || m.volume;
+        CHECK(volume);
     }
     SECTION("transmissionTexture is not read: one warning") {
         const Loaded l = load_material(
