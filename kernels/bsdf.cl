@@ -2,14 +2,17 @@
  * against them keeps working whatever the material (docs/ESTIMATORS.md). Directions are unit and
  * in world space; wo (sp->wo) points toward the viewer, and sp->n is on its side.
  *
- * Two builds, chosen by the host from the scene (DESIGN.md "Radiometric contract": model no
+ * Three builds, chosen by the host from the scene (DESIGN.md "Radiometric contract": model no
  * more than a scene needs):
  *  - default: every surface is the course's Lambertian reflector, f_r = albedo/π, sampled by
  *    cosine (GI Compendium eq. 35; PBRT 3rd ed. 13.6.3);
  *  - -D MCRT_MATERIALS_GLTF: glTF 2.0's metallic-roughness BRDF (specification, Appendix B;
  *    KHR_materials_specular), f = (1 − metallic)·dielectric + metallic·metal, sampled by a lobe
  *    chosen by its estimated weight: the diffuse lobe by cosine, the specular lobe by GGX's
- *    visible normals (microfacet.cl). */
+ *    visible normals (microfacet.cl);
+ *  - -D MCRT_TRANSMISSION as well (a scene with KHR_materials_transmission): a third lobe of
+ *    glass, reflecting and transmitting through a dielectric interface (dielectric.cl), thin-walled
+ *    or bounding a volume, a pair of deltas when smooth. */
 #ifndef MCRT_BSDF_CL
 #define MCRT_BSDF_CL
 
