@@ -65,3 +65,38 @@ kernel void ggx_distribution(float alpha, float4 wo, uint count, global const fl
     float visible = ggx_g1(wo.z, alpha) * max(0.0f, dot(wo.xyz, n)) * D / wo.z;
     d[k] = (float4)(D, visible, 0.0f, 0.0f);
 }
+
+#if defined(MCRT_TRANSMISSION)
+/* Transmissive builds (-D MCRT_TRANSMISSION, tests/test_glass.cpp): as bsdf_samples and
+ * bsdf_evaluate for a surface point seen from its front (front ≠ 0) or back face; out[k] = (wi,
+ * pdf_w), f[k] = (f, cos_theta), lobe[k] the sample's BSDF_LOBE_* bits. */
+kernel void glass_samples(Material material, float4 wo, uint front, uint count, uint seed,
+                          global float4* out, global float4* f, global uint* lobe) {
+    uint k = (uint)get_global_id(0);
+    if (k >= count) return;
+    SurfacePoint sp = test_surface(material, wo.xyz);
+    sp.front = front != 0u;
+    uint4 h = pcg4d((uint4)(k, seed, 0x6CA5u, 0u));
+    BsdfSample s = bsdf_sample(&sp, (float2)(uint_to_unit_float(h.x), uint_to_unit_float(h.y)));
+    out[k] = (float4)(s.wi, s.pdf_w);
+    f[k] = (float4)(s.f, s.cos_theta);
+    lobe[k] = s.lobe;
+}
+
+kernel void glass_evaluate(Material material, float4 wo, uint front, uint count,
+                           global const float4* wi, global float* pdf, global float4* f) {
+    uint k = (uint)get_global_id(0);
+    if (k >= count) return;
+    SurfacePoint sp = test_surface(material, wo.xyz);
+    sp.front = front != 0u;
+    pdf[k] = bsdf_pdf_w(&sp, wi[k].xyz);
+    f[k] = (float4)(bsdf_eval(&sp, wi[k].xyz), 0.0f);
+}
+
+/* out[k] = (exact_exp2(x[k]), fresnel_dielectric(c[k], eta), 0, 0). */
+kernel void dielectric_values(uint count, float eta, global const float2* xc, global float2* out) {
+    uint k = (uint)get_global_id(0);
+    if (k >= count) return;
+    out[k] = (float2)(exact_exp2(xc[k].x), fresnel_dielectric(xc[k].y, eta));
+}
+#endif

@@ -56,7 +56,8 @@ inline float3 estimate_emitter_along(const SceneView* scene, const SurfacePoint*
     bool found;
     BsdfSample bs;
     if (by_cosine && scene->continuation) bs = bsdf_sample(sp, u);
-    if (by_cosine && scene->continuation && all(as_uint3(bs.wi) == as_uint3(wi)))
+    if (by_cosine && scene->continuation && all(as_uint3(bs.wi) == as_uint3(wi)) &&
+        bsdf_sample_is_direct(&bs))
         found = trace_bsdf_sample(scene, sp, &bs, rays, &seen);
     else
         found = trace_from(scene, sp, wi, rays, &seen);
@@ -90,8 +91,9 @@ inline float3 estimate_bsdf(const SceneView* scene, const SurfacePoint* sp,
     BsdfSample bs = bsdf_sample(sp, sample_2d(stream, DIM_DIRECTION));
     if (!(bs.pdf_w > 0.0f) || bs.cos_theta <= 0.0f) return (float3)(0.0f);
     SurfacePoint seen;
-    float3 Le = trace_bsdf_sample(scene, sp, &bs, rays, &seen) ? emitted_radiance(&seen)
-                                                               : environment_radiance(scene);
+    bool found = trace_bsdf_sample(scene, sp, &bs, rays, &seen);
+    if (!bsdf_sample_is_direct(&bs)) return (float3)(0.0f); /* the path counts what it finds */
+    float3 Le = found ? emitted_radiance(&seen) : environment_radiance(scene);
     return bs.f * Le * (bs.cos_theta / bs.pdf_w);
 }
 
@@ -121,7 +123,10 @@ inline float3 estimate_mis(const SceneView* scene, const SurfacePoint* sp,
     BsdfSample bs = bsdf_sample(sp, sample_2d(stream, DIM_DIRECTION));
     SurfacePoint seen;
     if (bs.pdf_w > 0.0f && bs.cos_theta > 0.0f) {
-        if (trace_bsdf_sample(scene, sp, &bs, rays, &seen)) {
+        bool found = trace_bsdf_sample(scene, sp, &bs, rays, &seen);
+        if (!bsdf_sample_is_direct(&bs)) {
+            /* Through the surface or along a delta: the path counts what it finds. */
+        } else if (found) {
             float3 Le = emitted_radiance(&seen);
             if (any(Le != (float3)(0.0f))) {
                 float pdf_light = pdf_light_area(scene, sp, &seen, bs.wi);

@@ -157,6 +157,28 @@ inline float exact_hypot(float x, float y) {
     return sqrt(fma(hi, hi, lo * lo)) * unscale;
 }
 
+/* ---- exp2 -------------------------------------------------------------------------------- */
+
+/* 2^x = 2^k · 2^f with k = rint(x) and f = x − k in [−1/2, 1/2] (both exact); 2^f = e^(f ln 2) by
+ * its Taylor series to degree 7, whose remainder is below 6e-9 (0.1 ulp), in Horner form with
+ * fma; then 2^k by ldexp (exact, or rounded once into the denormals). 0 for x ≤ −150, +∞ for
+ * x ≥ 128, NaN for NaN. What Beer–Lambert attenuation needs (kernels/dielectric.cl). */
+inline float exact_exp2(float x) {
+    if (x != x) return x;
+    if (x <= -150.0f) return 0.0f;
+    if (x >= 128.0f) return INFINITY;
+    float k = rint(x);
+    float f = x - k;
+    float p = fma(f, 0x1.ffcbfcp-17f, 0x1.430912p-13f);
+    p = fma(f, p, 0x1.5d87fep-10f);
+    p = fma(f, p, 0x1.3b2ab6p-7f);
+    p = fma(f, p, 0x1.c6b08ep-5f);
+    p = fma(f, p, 0x1.ebfbe0p-3f);
+    p = fma(f, p, 0x1.62e430p-1f);
+    p = fma(f, p, 1.0f);
+    return ldexp(p, (int)k);
+}
+
 /* ---- Vectors ----------------------------------------------------------------------------- */
 
 /* (a.x·b.x + a.y·b.y) + a.z·b.z, every product and sum rounded, in this order. */

@@ -33,6 +33,19 @@ inline void set_alpha_key(const SceneView* scene, const SampleStream* stream) {
 #endif
 }
 
+#if defined(MCRT_TRANSMISSION)
+/* The transmittance of the segment of length t that sample bs starts at sp: Beer–Lambert
+ * (dielectric.cl) where it runs inside sp's volume — transmitted into it from the outside (front)
+ * or reflected from the inside (back) — else 1. A volume's own surfaces bound it: what another
+ * surface inside it sends is not attenuated (no nested media). */
+inline float3 segment_transmittance(const SurfacePoint* sp, const BsdfSample* bs, float t) {
+    if ((sp->material.flags & MATERIAL_VOLUME) == 0u) return (float3)(1.0f);
+    bool transmitted = (bs->lobe & BSDF_LOBE_TRANSMITTED) != 0u;
+    if (transmitted != sp->front) return (float3)(1.0f);
+    return beer_lambert(sp->material.attenuation.xyz, t);
+}
+#endif
+
 /* Radiance arriving along camera ray r after at most max_depth reflections: L_e at the first hit,
  * plus at each vertex k < max_depth the throughput times the estimator's estimate of the light
  * reflected there directly (its own strategies; emitters that the continuation later finds are
@@ -40,7 +53,9 @@ inline void set_alpha_key(const SceneView* scene, const SampleStream* stream) {
  * (trace_bsdf_sample, api.cl: the BSDF and MIS estimators hand theirs, as pbrt's path tracer
  * shares one sample), else the path's own draw with the vertex's DIM_DIRECTION numbers. A camera
  * ray leaving the scene sees black or the sky light; with an ambient estimator, which has no
- * path (-D MCRT_AMBIENT_ESTIMATOR), the sky (DESIGN.md "Radiometric contract"). */
+ * path (-D MCRT_AMBIENT_ESTIMATOR), the sky (DESIGN.md "Radiometric contract"). With transmissive
+ * materials (-D MCRT_TRANSMISSION) the path also adds what a continuation that no light strategy
+ * could have drawn (bsdf_sample_is_direct false) finds, and attenuates segments inside volumes. */
 inline float3 path_radiance(const SceneView* scene, const Ray* r, SampleStream* stream,
                             uint max_depth, uint rr_depth, PathRecord* record) {
     PathContinuation* given = scene->continuation; /* 0 for direct lighting */
@@ -85,12 +100,24 @@ inline float3 path_radiance(const SceneView* scene, const Ray* r, SampleStream* 
         }
 
         SurfacePoint next;
+#if defined(MCRT_TRANSMISSION)
+        bool found = handed ? given->found : trace_from(scene, &sp, bs.wi, &record->rays, &next);
+        if (handed && found) next = given->seen;
+        /* Beer–Lambert along a segment inside a volume; then the light that this sample finds
+         * where the estimators' light strategies could not look (through a surface, or along a
+         * delta): the emitter it hits, or the sky it leaves to. */
+        beta *= segment_transmittance(&sp, &bs, found ? length(next.p - sp.p) : MAXFLOAT);
+        if (!bsdf_sample_is_direct(&bs))
+            L += beta * (found ? emitted_radiance(&next) : environment_radiance(scene));
+        if (!found) break;
+#else
         if (handed) {
             if (!given->found) break;
             next = given->seen;
         } else if (!trace_from(scene, &sp, bs.wi, &record->rays, &next)) {
             break;
         }
+#endif
         sp = next;
         record->vertices += 1u;
     }

@@ -199,12 +199,19 @@ inline bool visible(const SceneView* scene, const SurfacePoint* sp, float3 y, fl
 }
 
 /* The first surface along direction wi (unit, world) from sp, leaving its surface as visible
- * does (its triangle skipped, the origin off its plane by its error bound); false
+ * does (its triangle skipped, the origin off its plane by its error bound, on wi's side); false
  * when the ray leaves the scene. Counts the ray in *rays. */
 inline bool trace_from(const SceneView* scene, const SurfacePoint* sp, float3 wi, uint* rays,
                        SurfacePoint* seen) {
     *rays += 1u;
+#if defined(MCRT_TRANSMISSION)
+    /* A transmitted direction leaves on the far side, beyond the error bound there. */
+    float3 o = dot(wi, sp->ng) < 0.0f ? offset_ray_origin(sp->p, sp->p_error, -sp->ng)
+                                      : spawn_origin(sp);
+    Ray r = make_ray(o, wi);
+#else
     Ray r = make_ray(spawn_origin(sp), wi);
+#endif
     AlphaTest at = ray_alpha_test(scene, &r);
     Hit hit = bvh_closest_hit(scene->nodes, scene->packets, &r, MAXFLOAT, sp->lane, &at);
     bool found = hit.lane != MCRT_NO_HIT;

@@ -135,6 +135,10 @@ typedef struct {
 #define MATERIAL_TEXTURED 2u
 /* alphaMode MASK or BLEND: every ray query tests the surface's alpha at a candidate hit. */
 #define MATERIAL_ALPHA_TESTED 4u
+/* KHR_materials_volume with thicknessFactor > 0 on a transmissive material: the surface bounds a
+ * volume (its outside the front face); rays refract and are attenuated inside (bsdf.cl, path.cl).
+ * Without it a transmissive surface is thin-walled. */
+#define MATERIAL_VOLUME 8u
 
 /* Material.type: the reflection model of a surface. The kernels' build follows the scene
  * (DESIGN.md "Radiometric contract": model no more than a scene needs): a scene whose every
@@ -144,18 +148,23 @@ typedef struct {
 #define MATERIAL_LAMBERTIAN 0u
 #define MATERIAL_METALLIC_ROUGHNESS 1u
 
-/* A surface's material, 64 bytes: glTF 2.0 metallic-roughness that may emit (DESIGN.md
- * "Radiometric contract"). */
+/* A surface's material, 96 bytes: glTF 2.0 metallic-roughness that may emit and transmit
+ * (DESIGN.md "Radiometric contract"). */
 typedef struct {
     float4 base_color; /* .xyz baseColorFactor, linear; .w its alpha */
     float4 emission;   /* .xyz emitted radiance (emissiveFactor × emissive_strength); .w 0 */
-    float4 specular;   /* the dielectric's Schlick pair (KHR_materials_specular): .xyz F0 =
-                          min(0.04 specularColorFactor, 1) × specularFactor, .w F90 =
+    float4 specular;   /* the dielectric's Schlick pair (KHR_materials_specular, _ior): .xyz F0 =
+                          min(f0(ior) specularColorFactor, 1) × specularFactor, .w F90 =
                           specularFactor */
     float metallic;    /* metallicFactor */
     float alpha;       /* GGX α = max(roughness², MCRT_ALPHA_MIN) */
     uint type;         /* MATERIAL_LAMBERTIAN or MATERIAL_METALLIC_ROUGHNESS */
-    uint flags;        /* MATERIAL_DOUBLE_SIDED */
+    uint flags;        /* MATERIAL_DOUBLE_SIDED, MATERIAL_VOLUME, ... */
+    float4 attenuation; /* MATERIAL_VOLUME: .xyz Beer–Lambert attenuation per unit length in bits,
+                           −log2(attenuationColor)/attenuationDistance (0: none); .w 0 */
+    float transmission; /* KHR_materials_transmission.transmissionFactor; 0: opaque */
+    float ior;          /* KHR_materials_ior.ior (≥ 1, or 0: the Fresnel term is 1) */
+    uint pad0, pad1;
 } Material;
 
 /* The least GGX α: roughness 0 (a mirror, a delta the estimators cannot sample) is read as
@@ -387,9 +396,10 @@ enum RenderArgument {
     TYPE(TriangleInfo, 8, 4) FIELD(TriangleInfo, material, 0) FIELD(TriangleInfo, light, 4)     \
     TYPE(Triangle, 64, 16) FIELD(Triangle, p0, 0) FIELD(Triangle, p1, 16)                       \
     FIELD(Triangle, p2, 32) FIELD(Triangle, material, 48) FIELD(Triangle, index, 52)            \
-    TYPE(Material, 64, 16) FIELD(Material, base_color, 0) FIELD(Material, emission, 16)         \
+    TYPE(Material, 96, 16) FIELD(Material, base_color, 0) FIELD(Material, emission, 16)         \
     FIELD(Material, specular, 32) FIELD(Material, metallic, 48) FIELD(Material, alpha, 52)      \
-    FIELD(Material, type, 56) FIELD(Material, flags, 60)                                        \
+    FIELD(Material, type, 56) FIELD(Material, flags, 60) FIELD(Material, attenuation, 64)       \
+    FIELD(Material, transmission, 80) FIELD(Material, ior, 84)                                  \
     TYPE(Light, 80, 16) FIELD(Light, p0, 0) FIELD(Light, p1, 16) FIELD(Light, p2, 32)           \
     FIELD(Light, Le, 48) FIELD(Light, area, 64) FIELD(Light, flags, 68)                         \
     FIELD(Light, material, 72) FIELD(Light, surface, 76)                                        \

@@ -135,23 +135,33 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
     data.packets = bvh.packets;
     for (const Material& m : scene.materials) {
         gpu::Material g{};
-        // KHR_materials_specular: the dielectric's F0 = min(0.04 specularColor, 1) × specular
-        // and F90 = specular; GGX α = roughness², at least MCRT_ALPHA_MIN.
+        // KHR_materials_specular with KHR_materials_ior: the dielectric's F0 = min(f0(ior) ×
+        // specularColor, 1) × specular and F90 = specular; GGX α = roughness², at least
+        // MCRT_ALPHA_MIN.
         const float alpha = std::max(m.roughness * m.roughness, MCRT_ALPHA_MIN);
         g.base_color = to_float4(m.albedo, 1.0f);
         g.emission = to_float4(m.emission);
-        g.specular = to_float4(glm::min(0.04f * m.specular_color, glm::vec3(1.0f)) * m.specular,
+        g.specular = to_float4(glm::min(dielectric_f0(m.ior) * m.specular_color, glm::vec3(1.0f)) *
+                                   m.specular,
                                m.specular);
         g.metallic = m.metallic;
         g.alpha = alpha;
         g.type = m.lambertian() ? MATERIAL_LAMBERTIAN : MATERIAL_METALLIC_ROUGHNESS;
         g.flags = m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u;
+        // KHR_materials_transmission, _ior, _volume (kernels/bsdf.cl, dielectric.cl).
+        g.transmission = m.transmission;
+        g.ior = m.ior;
+        if (m.transmission > 0.0f && m.volume) {
+            g.flags |= MATERIAL_VOLUME;
+            g.attenuation = to_float4(glm::vec3(volume_attenuation(m)));
+        }
         const bool slots = m.base_color_texture.used() || m.metallic_roughness_texture.used() ||
                            m.normal_texture.used() || m.emissive_texture.used();
         if (slots) g.flags |= MATERIAL_TEXTURED;
         if (m.alpha_mode != AlphaMode::Opaque) g.flags |= MATERIAL_ALPHA_TESTED;
         data.materials.push_back(g);
         data.microfacet = data.microfacet || g.type != MATERIAL_LAMBERTIAN;
+        data.transmission = data.transmission || m.transmission > 0.0f;
         data.textured = data.textured || m.textured();
     }
     if (data.materials.empty()) data.materials.push_back(gpu::Material{});

@@ -34,6 +34,9 @@ struct GpuSceneData {
     // Some material's type is not MATERIAL_LAMBERTIAN: the kernels need that model (-D
     // MCRT_MATERIALS_GLTF); a Lambertian scene's kernels are built without it.
     bool microfacet = false;
+    // Some material transmits (Material::transmission > 0): the kernels need the dielectric
+    // BTDF and the path's handling of what light strategies cannot reach (-D MCRT_TRANSMISSION).
+    bool transmission = false;
     // Some material has a texture or tests alpha (Material::textured): the kernels need texture
     // lookups (-D MCRT_TEXTURES), and these two arrays; an untextured scene leaves them empty.
     bool textured = false;

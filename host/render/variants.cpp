@@ -127,7 +127,8 @@ RenderVariants resolve_variants(const RenderSettings& settings) {
     return v;
 }
 
-std::string variant_program_options(const RenderVariants& v, bool microfacet, bool textured) {
+std::string variant_program_options(const RenderVariants& v, bool microfacet, bool textured,
+                                    bool transmission) {
     std::string options = std::string("-cl-std=CL1.2 -D MCRT_ESTIMATE=") + v.estimator.function;
     if (v.ambient()) options += " -D MCRT_AMBIENT_ESTIMATOR";
     options += std::string(" -D ") + v.light_select->macro;
@@ -140,6 +141,9 @@ std::string variant_program_options(const RenderVariants& v, bool microfacet, bo
     // Texture lookups and alpha tests only for a scene that has them (DESIGN.md "Radiometric
     // contract": model no more than a scene needs).
     if (textured) options += " -D MCRT_TEXTURES";
+    // Glass only for a scene that has it, and only in the glTF model (--materials lambert makes
+    // every surface opaque).
+    if (transmission && microfacet && v.materials->macro) options += " -D MCRT_TRANSMISSION";
     return options;
 }
 

@@ -1,6 +1,6 @@
 // glTF materials as mcrt's Material: the metallic-roughness factors (glTF 2.0 Appendix B),
-// emission with KHR_materials_emissive_strength, KHR_materials_specular, the alpha mode and the
-// texture slots (gltf_textures.cpp); what is ignored warned.
+// emission with KHR_materials_emissive_strength, KHR_materials_specular, KHR_materials_ior,
+// KHR_materials_transmission and KHR_materials_volume, the alpha mode and the texture slots (gltf_textures.cpp); what is ignored warned.
 #include "scene/gltf_materials.h"
 
 #include <algorithm>
@@ -35,7 +35,7 @@ float unit_factor(double value, const char* what, const std::string& element, Di
 
 // glTF 2.0 Appendix B's parameters: metallicFactor, roughnessFactor (default 1 each), and
 // KHR_materials_specular's specularFactor (default 1) and specularColorFactor (default 1, 1, 1;
-// F0 = min(0.04 × it, 1) is clamped where the BRDF is built, host/render/gpu_scene.cpp).
+// F0 = min(f0(ior) × it, 1) is clamped where the BRDF is built, host/render/gpu_scene.cpp).
 void read_microfacet_factors(const tinygltf::Material& source, const std::string& element,
                              Diagnostics& diag, Material& material) {
     const auto& pbr = source.pbrMetallicRoughness;
@@ -67,6 +67,98 @@ void read_microfacet_factors(const tinygltf::Material& source, const std::string
                       "non-negative numbers");
         }
         material.specular_color = glm::vec3(c);
+    }
+}
+
+// A number of an extension object, or NaN where it is there but not a number (refused by the
+// caller's finiteness check); `fallback` where it is absent.
+double extension_number(const tinygltf::Value& ext, const char* name, double fallback) {
+    if (!ext.Has(name)) return fallback;
+    const tinygltf::Value& v = ext.Get(name);
+    return v.IsNumber() ? v.GetNumberAsDouble() : std::numeric_limits<double>::quiet_NaN();
+}
+
+// The largest index of refraction read as given; beyond it (F0 > 0.9996) the value is clamped,
+// so that ior² stays far from float's range in the kernels.
+constexpr double kMaxIor = 1e4;
+
+// KHR_materials_ior: `ior` ≥ 1, or exactly 0 (the extension's specular-glossiness mode, where
+// the Fresnel term is 1); default 1.5. Not a finite number: refused. Below 1 (but not 0): the
+// default with one warning. Above kMaxIor: clamped with one warning.
+void read_ior(const tinygltf::Material& source, const std::string& element, Diagnostics& diag,
+              Material& material) {
+    material.ior = 1.5f;
+    const auto extension = source.extensions.find("KHR_materials_ior");
+    if (extension == source.extensions.end() || !extension->second.IsObject()) return;
+    double ior = extension_number(extension->second, "ior", 1.5);
+    if (!std::isfinite(ior)) diag.fail(element, "KHR_materials_ior.ior must be a finite number");
+    if (ior != 0.0 && ior < 1.0) {
+        diag.warn_once("ior-range", element + ": KHR_materials_ior.ior " + format_number(ior) +
+                                        " is neither 0 nor at least 1; the default 1.5 is used");
+        ior = 1.5;
+    } else if (ior > kMaxIor) {
+        diag.warn_once("ior-large", element + ": KHR_materials_ior.ior " + format_number(ior) +
+                                        " is above " + format_number(kMaxIor) + "; clamped");
+        ior = kMaxIor;
+    }
+    material.ior = float(ior);
+}
+
+// The extension object `name` of a material, or null where it is absent (or not an object).
+const tinygltf::Value* extension_object(const tinygltf::Material& source, const char* name) {
+    const auto extension = source.extensions.find(name);
+    if (extension == source.extensions.end() || !extension->second.IsObject()) return nullptr;
+    return &extension->second;
+}
+
+// KHR_materials_transmission: transmissionFactor in [0, 1] (default 0). Its texture is not
+// read: the factor holds over the whole surface (one warning).
+// KHR_materials_volume (only with transmission): thicknessFactor ≥ 0 (default 0, thin-walled);
+// > 0 makes the surface bound a volume (thicknessTexture only matters to rasterizers that
+// fake refraction, and is not read); attenuationColor in [0, 1]³ (default white), clamped with
+// one warning; attenuationDistance > 0 (default ∞): 0 or negative is read as ∞, with one warning.
+void read_transmission(const tinygltf::Material& source, const std::string& element,
+                       Diagnostics& diag, Material& material) {
+    const tinygltf::Value* ext = extension_object(source, "KHR_materials_transmission");
+    if (!ext) return;
+    material.transmission =
+        unit_factor(extension_number(*ext, "transmissionFactor", 0.0),
+                    "KHR_materials_transmission.transmissionFactor", element, diag);
+    if (ext->Has("transmissionTexture")) {
+        diag.warn_once("transmission-texture",
+                       element + ": KHR_materials_transmission.transmissionTexture is not "
+                                 "read; transmissionFactor holds over the whole surface");
+    }
+    const tinygltf::Value* volume = extension_object(source, "KHR_materials_volume");
+    if (!volume || material.transmission == 0.0f) return;
+    const double thickness = extension_number(*volume, "thicknessFactor", 0.0);
+    if (!std::isfinite(thickness) || thickness < 0.0) {
+        diag.fail(element, "KHR_materials_volume.thicknessFactor must be a finite number >= 0");
+    }
+    material.volume = thickness > 0.0;
+    double distance = extension_number(*volume, "attenuationDistance",
+                                       std::numeric_limits<double>::infinity());
+    if (std::isnan(distance)) {
+        diag.fail(element, "KHR_materials_volume.attenuationDistance must be a number > 0");
+    }
+    if (!(distance > 0.0)) {
+        diag.warn_once("attenuation-distance",
+                       element + ": KHR_materials_volume.attenuationDistance " +
+                           format_number(distance) + " is not above 0; no attenuation");
+        distance = std::numeric_limits<double>::infinity();
+    }
+    material.attenuation_distance = float(distance);  // beyond float's range: ∞, no loss
+    if (volume->Has("attenuationColor")) {
+        const tinygltf::Value& v = volume->Get("attenuationColor");
+        if (!v.IsArray() || v.ArrayLen() != 3) {
+            diag.fail(element, "KHR_materials_volume.attenuationColor must be 3 numbers");
+        }
+        for (int k = 0; k < 3; ++k) {
+            const tinygltf::Value& c = v.Get(k);
+            material.attenuation_color[k] = unit_factor(
+                c.IsNumber() ? c.GetNumberAsDouble() : std::numeric_limits<double>::quiet_NaN(),
+                "KHR_materials_volume.attenuationColor", element, diag);
+        }
     }
 }
 
@@ -147,11 +239,6 @@ void warn_unsupported_parts(const tinygltf::Material& material, Diagnostics& dia
         // A path tracer's light transport computes the occlusion such a map approximates.
         diag.warn_once("occlusion",
                        "occlusionTexture is not used: the light transport computes occlusion");
-    }
-    if (material.extensions.count("KHR_materials_transmission")) {
-        diag.warn_once("transmission",
-                       "KHR_materials_transmission is not supported; surfaces are opaque "
-                       "(reflection only)");
     }
 }
 
@@ -251,6 +338,8 @@ Material MaterialTable::convert(int material_index, const std::string& referrer)
     }
     material.double_sided = source.doubleSided;
     read_microfacet_factors(source, element, diag_, material);
+    read_ior(source, element, diag_, material);
+    read_transmission(source, element, diag_, material);
     read_alpha(source, element, diag_, material);
     read_texture_slots(source, element, textures_, diag_, material);
     return material;

@@ -1,7 +1,8 @@
 // The glTF materials a scene uses, converted to mcrt's Material (DESIGN.md "Radiometric
 // contract"): factors, alpha mode and the base colour, metallic-roughness, normal and emissive
-// texture slots (their images decoded once the scene is walked, gltf_images.h). Occlusion
-// textures and transmission are warned about and ignored.
+// texture slots (their images decoded once the scene is walked, gltf_images.h), index of
+// refraction, transmission and volume factors. Occlusion and transmission textures are warned
+// about and ignored.
 #pragma once
 
 #include <tiny_gltf.h>

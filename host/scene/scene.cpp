@@ -105,6 +105,7 @@ void make_lambertian(std::vector<Material>& materials) {
     for (Material& m : materials) {
         m.metallic = 0.0f;
         m.specular = 0.0f;
+        m.transmission = 0.0f;
     }
 }
 

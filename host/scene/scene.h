@@ -1,7 +1,10 @@
 // The minimal scene model: triangles, materials, camera — nothing else (DESIGN.md "Data flow").
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -53,6 +56,17 @@ struct Material {
     float roughness = 1.0f;    // roughnessFactor, [0, 1]; GGX α = roughness²
     float specular = 0.0f;     // KHR_materials_specular.specularFactor, [0, 1]; glTF default 1
     glm::vec3 specular_color{1.0f};  // KHR_materials_specular.specularColorFactor, ≥ 0
+    // KHR_materials_ior: the dielectric's F0 = ((ior − 1)/(ior + 1))², 0.04 at the default 1.5;
+    // ior is ≥ 1, or exactly 0, the extension's specular-glossiness mode (F = 1 everywhere).
+    float ior = 1.5f;
+    // KHR_materials_transmission.transmissionFactor, [0, 1]: the share of the dielectric that is
+    // a rough dielectric BTDF (glass) instead of the diffuse base; 0 is opaque.
+    float transmission = 0.0f;
+    // KHR_materials_volume with thicknessFactor > 0: a transmissive surface bounds a volume
+    // (refraction, attenuation inside); else it is thin-walled.
+    bool volume = false;
+    glm::vec3 attenuation_color{1.0f};  // attenuationColor, [0, 1]
+    float attenuation_distance = std::numeric_limits<float>::infinity();  // > 0; ∞: no loss
     float alpha = 1.0f;        // baseColorFactor.a, [0, 1]
     AlphaMode alpha_mode = AlphaMode::Opaque;
     float alpha_cutoff = 0.5f; // MASK only
@@ -72,8 +86,31 @@ struct Material {
     }
 
     // Exactly the Lambertian albedo/π: no metal, and no specular layer on the dielectric.
-    bool lambertian() const { return metallic == 0.0f && specular == 0.0f; }
+    bool lambertian() const {
+        return metallic == 0.0f && specular == 0.0f && transmission == 0.0f;
+    }
 };
+
+// KHR_materials_ior's dielectric F0 = ((ior − 1)/(ior + 1))², in double and rounded once: exactly
+// 0.04f at the default ior 1.5, 1 at ior 0 (the extension's specular-glossiness mode).
+inline float dielectric_f0(float ior) {
+    const double r = (double(ior) - 1.0) / (double(ior) + 1.0);
+    return float(r * r);
+}
+
+// Beer–Lambert attenuation per unit length in bits, −log2(attenuationColor)/attenuationDistance
+// per channel (transmittance 2^(−a·t), kernels/dielectric.cl): 0 for an infinite distance or a
+// white colour; a black channel's is large but finite (1e30), so that a·0 stays 0.
+inline glm::dvec3 volume_attenuation(const Material& m) {
+    glm::dvec3 a(0.0);
+    if (!std::isfinite(m.attenuation_distance)) return a;
+    for (int c = 0; c < 3; ++c) {
+        const double color = m.attenuation_color[c];
+        a[c] = color > 0.0 ? std::min(-std::log2(color) / double(m.attenuation_distance), 1e30)
+                           : 1e30;
+    }
+    return a;
+}
 
 // `--materials lambert`: every surface the course's Lambertian reflector of its baseColor.
 void make_lambertian(std::vector<Material>& materials);
