@@ -15,8 +15,11 @@ float3 estimate(const SceneView* scene, const SurfacePoint* sp, const SampleStre
     if (!(bs.pdf_w > 0.0f) || bs.cos_theta <= 0.0f) return (float3)(0.0f);
 
     SurfacePoint seen;
+    bool found = trace_bsdf_sample(scene, sp, &bs, rays, &seen);
+    /* Through glass or off a mirror (a delta or transmitted sample, docs/ESTIMATORS.md) the path
+     * counts what the direction finds; counted here too, it would count twice. */
+    if (!bsdf_sample_is_direct(&bs)) return (float3)(0.0f);
     /* A direction that leaves the scene sees the sky light (black without --sky). */
-    float3 Le = trace_bsdf_sample(scene, sp, &bs, rays, &seen) ? emitted_radiance(&seen)
-                                                          : environment_radiance(scene);
+    float3 Le = found ? emitted_radiance(&seen) : environment_radiance(scene);
     return bs.f * Le * (bs.cos_theta / bs.pdf_w);
 }
