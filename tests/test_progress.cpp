@@ -43,7 +43,8 @@ std::string written(std::FILE* file) {
 }
 }  // namespace
 
-TEST_CASE("without a terminal, progress is a line per tenth, at most one a second", "[cli][progress]") {
+TEST_CASE("without a terminal, progress is a line at the start, then per tenth, at most one a second",
+          "[cli][progress]") {
     const uint64_t pixels = 1000;
     std::FILE* log = std::tmpfile();
     REQUIRE(log);
@@ -54,10 +55,11 @@ TEST_CASE("without a terminal, progress is a line per tenth, at most one a secon
     };
     {
         ProgressBar bar(true, pixels, false, log);
-        bar.update(0, 100, {device_with(5 * pixels)}, at(0.0));     // 5%: no tenth yet
-        bar.update(0, 100, {device_with(12 * pixels)}, at(0.5));    // 12%: a line
-        bar.update(16, 100, {device_with(25 * pixels)}, at(0.9));   // 25%: 0.4 s later, none
-        bar.update(16, 100, {device_with(31 * pixels)}, at(2.0));   // 31%: a line
+        bar.update(0, 100, {}, at(0.0));                            // the start: a line
+        bar.update(0, 100, {device_with(5 * pixels)}, at(1.5));     // 5%: no tenth yet
+        bar.update(0, 100, {device_with(12 * pixels)}, at(1.6));    // 12%: a line
+        bar.update(16, 100, {device_with(25 * pixels)}, at(2.0));   // 25%: 0.4 s later, none
+        bar.update(16, 100, {device_with(31 * pixels)}, at(2.6));   // 31%: a line
         bar.update(32, 100, {device_with(39 * pixels)}, at(5.0));   // 39%: the same tenth
         bar.update(96, 100, {device_with(100 * pixels)}, at(6.0));  // all launched: 90%
         bar.update(100, 100, {device_with(100 * pixels)}, at(6.1)); // the image whole
@@ -69,7 +71,9 @@ TEST_CASE("without a terminal, progress is a line per tenth, at most one a secon
     CHECK(text.find('\r') == std::string::npos);
     size_t lines = 0;
     for (char c : text) lines += c == '\n';
-    CHECK(lines == 4);
+    CHECK(lines == 5);
+    CHECK(text.find("  0% 0/100 spp") != std::string::npos);
+    CHECK(text.find(" 5%") == std::string::npos);
     CHECK(text.find(" 12% 0/100 spp") != std::string::npos);
     CHECK(text.find(" 31% 16/100 spp") != std::string::npos);
     CHECK(text.find(" 96/100 spp") != std::string::npos);

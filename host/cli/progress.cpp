@@ -33,8 +33,8 @@ void ProgressBar::update(uint32_t done, uint32_t total, const std::vector<Device
     if (redraw_) {
         if (done < total && drawn_ && now - last_ < std::chrono::milliseconds(100)) return;
     } else {
-        // A tenth further than the last line, a second after it; the line at 100% when the
-        // image is whole.
+        // The first report; then a tenth further than the last line, a second after it; the
+        // line at 100% when the image is whole.
         const int tenths = done < total ? std::min(9, int(fraction * 10 + 1e-9)) : 10;
         if (tenths <= tenths_written_) return;
         if (done < total && drawn_ && now - last_ < std::chrono::seconds(1)) return;

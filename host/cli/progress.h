@@ -22,8 +22,8 @@ bool stderr_is_terminal();
 class ProgressBar {
 public:
     // On a terminal (`redraw`) one line redrawn in place with carriage returns; elsewhere (a log,
-    // a pipe) a line of its own at each further tenth of the render, at most one a second, and
-    // the last at 100%. Written to `out`.
+    // a pipe) lines of their own: the first when rendering starts, then one at each further
+    // tenth of the render, at most one a second, and the last at 100%. Written to `out`.
     ProgressBar(bool enabled, uint64_t samples_per_spp, bool redraw = stderr_is_terminal(),
                 std::FILE* out = stderr);
     ~ProgressBar() { finish(); }  // an error message then starts on a line of its own
@@ -42,7 +42,7 @@ private:
     uint64_t samples_per_spp_;
     bool redraw_;
     std::FILE* out_;
-    int tenths_written_ = 0;  // without redraw: the last tenth of the render a line was written at
+    int tenths_written_ = -1;  // without redraw: the tenth of the render of the last line written
     bool drawn_ = false;
     std::chrono::steady_clock::time_point start_, last_;
     // The first update with work done: rate and time left are measured from it, so that kernel
