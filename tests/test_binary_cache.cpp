@@ -19,6 +19,7 @@
 #include "cl/binary_cache.h"
 #include "cl/build_child.h"
 #include "cl/cl_error.h"
+#include "cl/pocl_binary.h"
 #include "cl/program.h"
 #include "device_support.h"
 
@@ -124,6 +125,47 @@ std::vector<char> read_bytes(const fs::path& path) {
 void write_bytes(const fs::path& path, const std::vector<char>& bytes) {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     out.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+// A PoCL binary of layout version 9 (cl/pocl_binary.cpp) with one kernel record: program.bc
+// holds `bc` bytes.
+std::vector<unsigned char> synthetic_pocl_binary(size_t bc) {
+    std::vector<unsigned char> b;
+    auto u32 = [&](uint32_t v) {
+        for (int i = 0; i < 4; ++i) b.push_back((unsigned char)(v >> (8 * i)));
+    };
+    auto u64 = [&](uint64_t v) {
+        for (int i = 0; i < 8; ++i) b.push_back((unsigned char)(v >> (8 * i)));
+    };
+    const std::string magic("poclbin\0", 8), path = "/program.bc";
+    b.insert(b.end(), magic.begin(), magic.end());
+    u64(0x1234);  // device id
+    u32(9);       // version
+    u32(1);       // kernels
+    u64(0);       // flags
+    u32(1);       // root entries
+    b.insert(b.end(), 41, 'a');  // build hash
+    u64(bc == 0 ? 0 : 4 + path.size() + 4 + bc);
+    if (bc > 0) {
+        u32(uint32_t(path.size()));
+        b.insert(b.end(), path.begin(), path.end());
+        u32(uint32_t(bc));
+        b.insert(b.end(), bc, 0x42);
+    }
+    u64(8 + 24);  // the kernel record, its size field included
+    b.insert(b.end(), 24, 0x17);
+    return b;
+}
+
+// `binary`, a PoCL binary of version 9, with its program.bc entry emptied, as PoCL serialises
+// it while another process has removed the file to rewrite it.
+std::vector<unsigned char> without_program_bc(std::vector<unsigned char> binary) {
+    const size_t at = 8 + 8 + 4 + 4 + 8 + 4 + 41;  // the first root entry's size
+    uint64_t size = 0;
+    for (int i = 7; i >= 0; --i) size = (size << 8) | binary.at(at + size_t(i));
+    binary.erase(binary.begin() + long(at + 8), binary.begin() + long(at + 8 + size));
+    for (size_t i = 0; i < 8; ++i) binary[at + i] = 0;
+    return binary;
 }
 
 }  // namespace
@@ -316,6 +358,55 @@ TEST_CASE("a corrupt entry is rebuilt from source and replaced", "[cache]") {
         REQUIRE(store_binary_cache_entry(first.path, key, garbage).empty());
         // PoCL refuses it at clCreateProgramWithBinary (CL_INVALID_BINARY), others may at build.
         CHECK_THAT(corrupted(read_bytes(first.path)), Catch::StartsWith("cl"));
+    }
+    SECTION("a PoCL binary without program.bc, never handed to the driver") {
+        // PoCL serialises such a binary while another process rewrites its cache, and aborts the
+        // process when asked to build it (pocl_binary_get_kernels_metadata: `len > 0').
+        const std::vector<unsigned char> payload(valid.begin() + 40, valid.end());
+        const bool pocl = pocl_binary_problem(payload).empty() &&
+                          std::string(valid.begin() + 40, valid.begin() + 48) ==
+                              std::string("poclbin\0", 8);
+        const std::vector<unsigned char> broken =
+            pocl ? without_program_bc(payload) : synthetic_pocl_binary(0);
+        BinaryCacheKey key = binary_cache_key(device.info, kSource, kOptions);
+        REQUIRE(store_binary_cache_entry(first.path, key, broken).empty());
+        CHECK_THAT(corrupted(read_bytes(first.path)), Catch::Contains("program.bc"));
+    }
+}
+
+TEST_CASE("a PoCL binary is whole only with program.bc and kernel records that fit", "[cache]") {
+    CHECK(pocl_binary_problem(synthetic_pocl_binary(16)).empty());
+    CHECK_THAT(pocl_binary_problem(synthetic_pocl_binary(0)),
+               Catch::Contains("root entry 0 (program.bc) is empty"));
+    std::vector<unsigned char> cut = synthetic_pocl_binary(16);
+    cut.resize(cut.size() - 1);
+    CHECK_THAT(pocl_binary_problem(cut), Catch::Contains("kernel record 0 has size 32"));
+    std::vector<unsigned char> longer = synthetic_pocl_binary(16);
+    longer.push_back(0);
+    CHECK_THAT(pocl_binary_problem(longer), Catch::Contains("1 bytes after the last kernel"));
+    std::vector<unsigned char> no_bytes = synthetic_pocl_binary(16);
+    no_bytes.resize(77 + 8 + 4 + 11 + 4);  // the file's content cut off
+    CHECK_THAT(pocl_binary_problem(no_bytes), Catch::Contains("runs past"));
+    // Not judged: another driver's binary, and a PoCL layout this check does not know.
+    CHECK(pocl_binary_problem({}).empty());
+    CHECK(pocl_binary_problem(std::vector<unsigned char>(100, 0x7f)).empty());
+    std::vector<unsigned char> newer = synthetic_pocl_binary(0);
+    newer[16] = 10;
+    CHECK(pocl_binary_problem(newer).empty());
+}
+
+TEST_CASE("the device's own binary of a program passes the PoCL check", "[cache]") {
+    // Guards the layout read by pocl_binary_problem against the installed PoCL: a misread would
+    // refuse every binary and so store none.
+    DeviceContext device = first_device();
+    cl::Program program = build_program(device.context, device.info.device, kSource, kOptions);
+    const std::vector<unsigned char> binary = program_binary(program, device.info.device);
+    REQUIRE_FALSE(binary.empty());
+    CHECK(pocl_binary_problem(binary).empty());
+    if (device.info.platform_name.find("Portable Computing Language") != std::string::npos) {
+        REQUIRE(std::string(binary.begin(), binary.begin() + 8) == std::string("poclbin\0", 8));
+        CHECK_THAT(pocl_binary_problem(without_program_bc(binary)),
+                   Catch::Contains("(program.bc) is empty"));
     }
 }
 

@@ -1,6 +1,6 @@
 // The corners' texture attributes of the glTF import (host/scene/gltf_attributes.cpp,
 // gltf_accessors.cpp), MikkTSpace's tangents among them: files written here in memory, each
-// checking one rule, and the textured scenes of ../shared/scenes/textured.
+// checking one rule, and the textured scenes of the extended set (../shared/scenes/textured).
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <chrono>
@@ -621,7 +621,7 @@ TEST_CASE("Merging duplicate emitters keeps the corner attributes beside their c
 }
 
 // ---------------------------------------------------------------------------------------------
-// The textured scenes of ../shared/scenes/textured
+// The textured scenes of the extended set (../shared/scenes/textured: Sponza's 55 MB among them)
 // ---------------------------------------------------------------------------------------------
 
 namespace {
@@ -659,8 +659,8 @@ NormalMapped normal_mapped_primitives(const json& doc) {
 }  // namespace
 
 TEST_CASE("Textured sample scenes: attributes parallel to positions, frames orthonormal",
-          "[gltf][attributes][textured]") {
-    const fs::path root = mcrt::test::shared_scene("textured");
+          "[gltf][attributes][textured][extended]") {
+    const fs::path root = mcrt::test::extended_scene("textured");
     std::vector<fs::path> files;
     for (const auto& dir : fs::directory_iterator(root)) {
         if (!dir.is_directory()) continue;

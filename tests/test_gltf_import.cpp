@@ -17,7 +17,8 @@
 #include "scene/scene.h"
 #include "test_support.h"
 
-using mcrt::test::shared_scene;
+using mcrt::test::extended_scene;
+using mcrt::test::scene_path;
 
 namespace {
 
@@ -87,7 +88,7 @@ std::string file_name(const std::string& path) {
 // ---------------------------------------------------------------------------------------------
 
 TEST_CASE("Box: parent and child node matrices transform the 12 triangles", "[gltf][khronos]") {
-    const Loaded box = load(shared_scene("khronos/Box/Box.gltf"));
+    const Loaded box = load(scene_path("khronos/Box/Box.gltf"));
     const mcrt::Scene& scene = box.scene;
     CHECK(box.warnings.empty());
     REQUIRE(scene.triangle_count() == 12);
@@ -108,7 +109,7 @@ TEST_CASE("Box: parent and child node matrices transform the 12 triangles", "[gl
 }
 
 TEST_CASE("Triangle: no scene property and no material", "[gltf][khronos]") {
-    const mcrt::Scene scene = load(shared_scene("khronos/Triangle/Triangle.gltf")).scene;
+    const mcrt::Scene scene = load(scene_path("khronos/Triangle/Triangle.gltf")).scene;
     REQUIRE(scene.triangle_count() == 1);
     CHECK(near(vertex(scene, 0, 0), {0, 0, 0}));
     CHECK(near(vertex(scene, 0, 1), {1, 0, 0}));
@@ -123,7 +124,7 @@ TEST_CASE("Triangle: no scene property and no material", "[gltf][khronos]") {
 
 TEST_CASE("TriangleWithoutIndices: a non-indexed primitive", "[gltf][khronos]") {
     const mcrt::Scene scene =
-        load(shared_scene("khronos/TriangleWithoutIndices/TriangleWithoutIndices.gltf")).scene;
+        load(scene_path("khronos/TriangleWithoutIndices/TriangleWithoutIndices.gltf")).scene;
     REQUIRE(scene.triangle_count() == 1);
     CHECK(near(vertex(scene, 0, 0), {0, 0, 0}));
     CHECK(near(vertex(scene, 0, 1), {1, 0, 0}));
@@ -132,7 +133,7 @@ TEST_CASE("TriangleWithoutIndices: a non-indexed primitive", "[gltf][khronos]") 
 
 TEST_CASE("SimpleSparseAccessor: bounds reflect the sparse override", "[gltf][khronos]") {
     const mcrt::Scene scene =
-        load(shared_scene("khronos/SimpleSparseAccessor/SimpleSparseAccessor.gltf")).scene;
+        load(scene_path("khronos/SimpleSparseAccessor/SimpleSparseAccessor.gltf")).scene;
     REQUIRE(scene.triangle_count() == 12);
     // The base data lies in y ∈ [0, 1]; the sparse values move vertices 8, 10, 12 up to y = 4.
     CHECK(near(scene.bounds_min(), {0, 0, 0}));
@@ -144,7 +145,7 @@ TEST_CASE("SimpleSparseAccessor: bounds reflect the sparse override", "[gltf][kh
 
 TEST_CASE("MultipleScenes: only the default scene is imported", "[gltf][khronos]") {
     const mcrt::Scene scene =
-        load(shared_scene("khronos/MultipleScenes/MultipleScenes.gltf")).scene;
+        load(scene_path("khronos/MultipleScenes/MultipleScenes.gltf")).scene;
     // `scene` is 1: its mesh is the unit square (2 triangles); scene 0's single triangle is not
     // imported. Only the square has the corner (1, 1, 0).
     CHECK(scene.triangle_count() == 2);
@@ -153,7 +154,7 @@ TEST_CASE("MultipleScenes: only the default scene is imported", "[gltf][khronos]
 
 TEST_CASE("Cameras: the perspective camera is kept, the orthographic one warned about",
           "[gltf][khronos]") {
-    const Loaded loaded = load(shared_scene("khronos/Cameras/Cameras.gltf"));
+    const Loaded loaded = load(scene_path("khronos/Cameras/Cameras.gltf"));
     const mcrt::Scene& scene = loaded.scene;
     CHECK(scene.triangle_count() == 2);
     REQUIRE(scene.cameras.size() == 1);
@@ -170,7 +171,7 @@ TEST_CASE("Cameras: the perspective camera is kept, the orthographic one warned 
 
 TEST_CASE("McGuire Cornell box: 36 triangles, one camera, a light facing down", "[gltf][cornell]") {
     const mcrt::Scene scene =
-        load(shared_scene("cornell/mcguire_CornellBox-Original/CornellBox-Original.gltf")).scene;
+        load(scene_path("cornell/CornellBox-Original.gltf")).scene;
     CHECK(scene.triangle_count() == 36);
     REQUIRE(scene.cameras.size() == 1);
     CHECK(scene.cameras[0].yfov == Approx(glm::radians(39.3f)).epsilon(0.01));
@@ -194,7 +195,7 @@ TEST_CASE("McGuire Cornell box: 36 triangles, one camera, a light facing down", 
 }
 
 TEST_CASE("nvpro Cornell box: an instanced mesh and a double-sided box light", "[gltf][cornell]") {
-    const Loaded loaded = load(shared_scene("cornell/nvpro_cornellBox/cornellBox.gltf"));
+    const Loaded loaded = load(scene_path("cornell-nvpro/cornellBox.gltf"));
     const mcrt::Scene& scene = loaded.scene;
     // 16,720 unique triangles; one 12-triangle mesh is used by two nodes.
     CHECK(scene.triangle_count() == 16732);
@@ -217,7 +218,7 @@ TEST_CASE("nvpro Cornell box: an instanced mesh and a double-sided box light", "
 
 TEST_CASE("Modern Hall: mirrored emitters keep the front face Mitsuba emits from",
           "[gltf][lights]") {
-    const Loaded loaded = load(shared_scene("lights/modern-hall/modern-hall.gltf"));
+    const Loaded loaded = load(scene_path("modern-hall/modern-hall.gltf"));
     const mcrt::Scene& scene = loaded.scene;
     CHECK(scene.triangle_count() == 31247);
     CHECK(scene.cameras.size() == 1);
@@ -242,13 +243,15 @@ TEST_CASE("Modern Hall: mirrored emitters keep the front face Mitsuba emits from
     CHECK(glass == 1);
 }
 
-TEST_CASE("GLB files load: the fazil47 Cornell box and the Stanford bunny", "[gltf][glb]") {
-    const mcrt::Scene box = load(shared_scene("cornell/fazil47_cornell-box/cornell-box.glb")).scene;
+TEST_CASE("GLB files load: the fazil47 Cornell box", "[gltf][glb]") {
+    const mcrt::Scene box = load(scene_path("cornell-fazil47/cornell-box.glb")).scene;
     CHECK(box.triangle_count() == 1040);
     CHECK(box.cameras.empty());
     CHECK_FALSE(mcrt::collect_emitters(box).empty());
+}
 
-    const mcrt::Scene bunny = load(shared_scene("stanford/bunny_zipper.glb")).scene;
+TEST_CASE("GLB files load: the Stanford bunny", "[gltf][glb][extended]") {
+    const mcrt::Scene bunny = load(extended_scene("stanford/bunny_zipper.glb")).scene;
     CHECK(bunny.triangle_count() == 69451);
     CHECK(bunny.cameras.empty());
     CHECK(mcrt::collect_emitters(bunny).empty());
@@ -268,7 +271,7 @@ TEST_CASE("tinygltf robustness files either load or throw InputError", "[gltf][r
     };
     for (const std::string& file : files) {
         INFO(file);
-        const std::string path = shared_scene(file);
+        const std::string path = scene_path(file);
         try {
             mcrt::load_gltf(path, nullptr);
         } catch (const mcrt::InputError& e) {
@@ -276,8 +279,8 @@ TEST_CASE("tinygltf robustness files either load or throw InputError", "[gltf][r
         }
     }
     // The four BoundsChecking files are invalid.
-    for (size_t i = 0; i < 4; ++i) CHECK_FALSE(load_error(shared_scene(files[i])).empty());
-    CHECK(load(shared_scene("robustness/tinygltf/box01.glb")).scene.triangle_count() == 12);
+    for (size_t i = 0; i < 4; ++i) CHECK_FALSE(load_error(scene_path(files[i])).empty());
+    CHECK(load(scene_path("robustness/tinygltf/box01.glb")).scene.triangle_count() == 12);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -362,7 +365,7 @@ TEST_CASE("load_gltf_from_memory imports what load_gltf imports", "[gltf][memory
         CHECK(from_memory.triangle_material == from_file.triangle_material);
         CHECK(from_memory.materials.size() == from_file.materials.size());
     }
-    const std::string glb = shared_scene("robustness/tinygltf/box01.glb");
+    const std::string glb = scene_path("robustness/tinygltf/box01.glb");
     CHECK(mcrt::load_gltf_from_memory("box01.glb", file_bytes(glb), nullptr).triangle_count() ==
           12);
     // Broken files fail the same way, named by the name given.
@@ -407,7 +410,7 @@ TEST_CASE("Every file of the fuzz corpus loads or throws InputError", "[gltf][ro
 // Every integer of Box.gltf's JSON replaced, one at a time, by out-of-range or negative values:
 // each variant loads or throws InputError, never anything else.
 TEST_CASE("Box.gltf with corrupted indices and counts never crashes", "[gltf][robustness]") {
-    std::ifstream in(shared_scene("khronos/Box/Box.gltf"));
+    std::ifstream in(scene_path("khronos/Box/Box.gltf"));
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     const std::regex integer(R"((":\s*\[?\s*)(\d+)([,\s\]}]))");
     const std::filesystem::path dir = std::filesystem::temp_directory_path() / "mcrt_gltf_mutants";
@@ -646,10 +649,10 @@ TEST_CASE("bench_camera of an empty or point-like scene is still a valid frame",
 }
 
 TEST_CASE("Cameras of the test scenes are right-handed rigid frames", "[gltf][scene]") {
-    for (const char* file : {"khronos/Cameras/Cameras.gltf", "lights/modern-hall/modern-hall.gltf",
-                             "cornell/nvpro_cornellBox/cornellBox.gltf"}) {
+    for (const char* file : {"khronos/Cameras/Cameras.gltf", "modern-hall/modern-hall.gltf",
+                             "cornell-nvpro/cornellBox.gltf"}) {
         INFO(file);
-        const mcrt::Scene scene = load(shared_scene(file)).scene;
+        const mcrt::Scene scene = load(scene_path(file)).scene;
         REQUIRE_FALSE(scene.cameras.empty());
         for (const mcrt::Camera& camera : scene.cameras) check_rigid_frame(camera.camera_to_world);
     }

@@ -1005,7 +1005,7 @@ TEST_CASE("PNG scanline bytes: Adam7 passes counted texel by texel; JPEG blocks 
 }
 
 TEST_CASE("the textured sample scenes load with every used image decoded",
-          "[gltf][textures][shared]") {
+          "[gltf][textures]") {
     struct Expected {
         const char* scene;
         size_t images;
@@ -1019,7 +1019,7 @@ TEST_CASE("the textured sample scenes load with every used image decoded",
         {"textured/TextureTransformTest/TextureTransformTest.gltf", 5, 0, 0},
     };
     for (const Expected& e : expected) {
-        const std::string path = shared_scene(e.scene);
+        const std::string path = scene_path(e.scene);
         std::vector<std::string> warnings;
         const Scene scene = load_gltf(path, [&](const std::string& w) { warnings.push_back(w); });
         INFO(e.scene);
@@ -1034,7 +1034,7 @@ TEST_CASE("the textured sample scenes load with every used image decoded",
     }
     SECTION("TextureEncodingTest: gAMA and iCCP variants of a 1×1 green hold the same texel") {
         const Scene scene = load_gltf(
-            shared_scene("textured/TextureEncodingTest/TextureEncodingTest.gltf"), nullptr);
+            scene_path("textured/TextureEncodingTest/TextureEncodingTest.gltf"), nullptr);
         size_t one_by_one = 0;
         for (const TextureImage& image : scene.images) one_by_one += image.width == 1;
         CHECK(one_by_one == 6);

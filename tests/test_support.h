@@ -15,10 +15,18 @@ namespace mcrt::test {
     std::exit(4);
 }
 
-// Path of a file under ../shared/scenes, or a skip when that directory is absent.
-inline std::string shared_scene(const std::string& relative) {
-    std::string path = std::string(MCRT_SHARED_SCENES) + "/" + relative;
-    if (!std::filesystem::exists(path)) skip_test("shared scene not present: " + path);
+// Path of a scene shipped in the repository's scenes/ (scenes/SOURCES.md).
+inline std::string scene_path(const std::string& relative) {
+    return std::string(MCRT_SCENES) + "/" + relative;
+}
+
+// Path of a file under the directory of large scenes (the CMake cache variable
+// MCRT_EXTENDED_SCENES, ../shared/scenes by default), which only the tests tagged [extended]
+// use: ctest runs them (label `extended`, scripts/test --extended) only where that directory
+// existed when CMake configured the build. A skip if it has gone since.
+inline std::string extended_scene(const std::string& relative) {
+    std::string path = std::string(MCRT_EXTENDED_SCENES) + "/" + relative;
+    if (!std::filesystem::exists(path)) skip_test("extended scene not present: " + path);
     return path;
 }
 

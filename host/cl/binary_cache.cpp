@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iterator>
 #include <system_error>
+#include <thread>
 #include <vector>
 
 #include <fcntl.h>
@@ -23,6 +24,7 @@
 
 #include "cl/build_child.h"
 #include "cl/cl_error.h"
+#include "cl/pocl_binary.h"
 #include "cl/program.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
@@ -410,6 +412,33 @@ static cl::Program build_from_source(const cl::Context& context, const cl::Devic
     return program;
 }
 
+// The binary of `program`, or, when PoCL serialised it while another process was rewriting its
+// cache (pocl_binary.h), the binary of a fresh build of the same source, which PoCL reads from its
+// then settled cache: a few tries, a little apart. Empty with `why` set when none is whole.
+static std::vector<unsigned char> whole_binary(const cl::Program& program,
+                                               const cl::Context& context, const cl::Device& device,
+                                               const DeviceInfo& info, const std::string& source,
+                                               const std::string& options, bool in_child,
+                                               std::string& why) {
+    std::vector<unsigned char> binary = program_binary(program, device);
+    for (int attempt = 1; attempt <= 3; ++attempt) {
+        why = pocl_binary_problem(binary);
+        if (why.empty()) return binary;
+        std::this_thread::sleep_for(std::chrono::milliseconds(50 * attempt));
+        try {
+            binary = program_binary(
+                build_from_source(context, device, info, source, options, in_child), device);
+        } catch (const std::exception& e) {  // the cache never fails a build
+            why += "; not stored (its rebuild failed: " + std::string(e.what()) + ")";
+            return {};
+        }
+    }
+    why = pocl_binary_problem(binary);
+    if (why.empty()) return binary;
+    why += "; not stored";
+    return {};
+}
+
 cl::Program build_program_cached(const cl::Context& context, const cl::Device& device,
                                  const DeviceInfo& info, const std::string& source,
                                  const std::string& options, BuildReport* report,
@@ -432,6 +461,11 @@ cl::Program build_program_cached(const cl::Context& context, const cl::Device& d
     // Hit: a valid entry the driver accepts.
     std::vector<unsigned char> binary = read_entry(r.path, key, r.rejected);
     if (!binary.empty()) {
+        // PoCL aborts the process on a binary without program.bc rather than refusing it.
+        r.rejected = pocl_binary_problem(binary);
+        if (!r.rejected.empty()) binary.clear();
+    }
+    if (!binary.empty()) {
         cl::Program program = program_from_binary(context, device, binary, options, r.rejected);
         if (program()) {
             r.cache_hit = true;
@@ -449,7 +483,10 @@ cl::Program build_program_cached(const cl::Context& context, const cl::Device& d
         r.seconds = seconds_since(t0);
         return program;
     }
-    r.store_error = store_binary_cache_entry(r.path, key, program_binary(program, device));
+    std::string problem;
+    const std::vector<unsigned char> whole =
+        whole_binary(program, context, device, info, source, options, in_child, problem);
+    r.store_error = problem.empty() ? store_binary_cache_entry(r.path, key, whole) : problem;
     if (store_after_misses > 1 && r.store_error.empty()) ::unlink(counter.c_str());  // the name only
     r.seconds = seconds_since(t0);
     return program;

@@ -4,10 +4,14 @@
 #include <cstdio>
 #include <string>
 
+#include <unistd.h>
+
 namespace mcrt {
 
-ProgressBar::ProgressBar(bool enabled, uint64_t samples_per_spp)
-    : enabled_(enabled), samples_per_spp_(samples_per_spp),
+bool stderr_is_terminal() { return ::isatty(STDERR_FILENO) == 1; }
+
+ProgressBar::ProgressBar(bool enabled, uint64_t samples_per_spp, bool redraw, std::FILE* out)
+    : enabled_(enabled), samples_per_spp_(samples_per_spp), redraw_(redraw), out_(out),
       start_(std::chrono::steady_clock::now()), last_(start_) {}
 
 double progress_fraction(uint32_t done, uint32_t total, uint64_t samples_per_spp,
@@ -21,14 +25,23 @@ double progress_fraction(uint32_t done, uint32_t total, uint64_t samples_per_spp
     return std::min(1.0, std::max(committed, launched));
 }
 
-void ProgressBar::update(uint32_t done, uint32_t total, const std::vector<DeviceReport>& devices) {
+void ProgressBar::update(uint32_t done, uint32_t total, const std::vector<DeviceReport>& devices,
+                         std::chrono::steady_clock::time_point now) {
     if (!enabled_ || total == 0) return;
-    auto now = std::chrono::steady_clock::now();
-    if (done < total && drawn_ && now - last_ < std::chrono::milliseconds(100)) return;
-    last_ = now;
-    drawn_ = true;
     double fraction = progress_fraction(done, total, samples_per_spp_, devices);
     if (!started_ && fraction > 0) started_ = true, first_ = now, first_fraction_ = fraction;
+    if (redraw_) {
+        if (done < total && drawn_ && now - last_ < std::chrono::milliseconds(100)) return;
+    } else {
+        // The first report; then a tenth further than the last line, a second after it; the
+        // line at 100% when the image is whole.
+        const int tenths = done < total ? std::min(9, int(fraction * 10 + 1e-9)) : 10;
+        if (tenths <= tenths_written_) return;
+        if (done < total && drawn_ && now - last_ < std::chrono::seconds(1)) return;
+        tenths_written_ = tenths;
+    }
+    last_ = now;
+    drawn_ = true;
     // Rate and time left from the work done since the first report (none yet: unknown).
     double since = started_ ? std::chrono::duration<double>(now - first_).count() : 0.0;
     double progress = fraction - first_fraction_;
@@ -74,13 +87,14 @@ void ProgressBar::update(uint32_t done, uint32_t total, const std::vector<Device
             shares += share;
         }
     }
-    std::fprintf(stderr, "\r[%s] %3d%% %u/%u spp  %.2f Msamples/s  %s s left%s ", bar,
-                 int(fraction * 100 + 0.5), done, total, rate * 1e-6, left, shares.c_str());
-    std::fflush(stderr);
+    std::fprintf(out_, "%s[%s] %3d%% %u/%u spp  %.2f Msamples/s  %s s left%s%s", redraw_ ? "\r" : "",
+                 bar, int(fraction * 100 + 0.5), done, total, rate * 1e-6, left, shares.c_str(),
+                 redraw_ ? " " : "\n");
+    std::fflush(out_);
 }
 
 void ProgressBar::finish() {
-    if (enabled_ && drawn_) std::fputc('\n', stderr);
+    if (enabled_ && drawn_ && redraw_) std::fputc('\n', out_);
     drawn_ = false;
 }
 
