@@ -1,5 +1,6 @@
-// Pearson's χ² test with Wilson–Hilferty critical values, shared by the sampling and BSDF
-// suites (tests/test_sampling.cpp, tests/test_materials.cpp).
+// Pearson's χ² test with Wilson–Hilferty critical values, and the expected counts of a direction
+// grid, shared by the sampling, BSDF and glass suites (tests/test_sampling.cpp,
+// tests/test_materials.cpp, tests/test_glass.cpp).
 #pragma once
 
 #include <algorithm>
@@ -9,6 +10,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <glm/glm.hpp>
 
 namespace mcrt::test {
 
@@ -64,6 +67,61 @@ inline Chi2 chi2_test(const std::string& name, const std::vector<double>& observ
     std::printf("chi2 %-44s statistic %10.1f  dof %5d  critical %8.1f\n", name.c_str(), r.statistic,
                 r.dof, r.critical);
     return r;
+}
+
+// The expected fraction of samples in each cell of a direction grid (HemisphereGrid,
+// SphereGrid: nt × np cells in θ and φ, a last cell for what is left): ∫ pdf_w over each cell by
+// the midpoint rule on m × m points weighted by sinθ, again on fine × fine points in the cells
+// where the pdf varies by more than 10% between their points (a grazing view's lobe is a thin
+// sliver, Jacobian 4 wo·h). `pdf_of(directions)` returns the pdf at each direction.
+template <class Grid, class PdfOf>
+std::vector<double> expected_cell_fractions(const Grid& g, int m, int fine, const PdfOf& pdf_of) {
+    auto integrate = [&](const std::vector<int>& cells, int q, std::vector<double>* spread) {
+        std::vector<glm::dvec3> w;
+        std::vector<double> weight;
+        w.reserve(cells.size() * q * q);
+        for (int cell : cells) {
+            int it = cell / g.np, ip = cell % g.np;
+            for (int a = 0; a < q; ++a)
+                for (int b = 0; b < q; ++b) {
+                    double t = (it + (a + 0.5) / q) * g.dt(), p = (ip + (b + 0.5) / q) * g.dp();
+                    w.push_back(g.direction(t, p));
+                    weight.push_back(std::sin(t) * g.dt() * g.dp() / (q * q));
+                }
+        }
+        const std::vector<float> pdf = pdf_of(w);
+        std::vector<double> out(cells.size(), 0.0);
+        if (spread) spread->assign(cells.size(), 0.0);
+        for (size_t c = 0; c < cells.size(); ++c) {
+            double lo = 1e300, hi = 0;
+            for (int k = 0; k < q * q; ++k) {
+                size_t j = c * q * q + k;
+                out[c] += pdf[j] * weight[j];
+                lo = std::min(lo, double(pdf[j]));
+                hi = std::max(hi, double(pdf[j]));
+            }
+            if (spread) (*spread)[c] = hi > 0 ? (hi - lo) / hi : 0.0;
+        }
+        return out;
+    };
+    std::vector<int> all(g.nt * g.np);
+    std::iota(all.begin(), all.end(), 0);
+    std::vector<double> spread;
+    std::vector<double> coarse = integrate(all, m, &spread);
+    std::vector<int> refine;
+    for (int c : all)
+        if (spread[c] > 0.1) refine.push_back(c);
+    for (size_t begin = 0; begin < refine.size(); begin += 256) {
+        std::vector<int> part(refine.begin() + begin,
+                              refine.begin() + std::min(refine.size(), begin + 256));
+        std::vector<double> v = integrate(part, fine, nullptr);
+        for (size_t k = 0; k < part.size(); ++k) coarse[part[k]] = v[k];
+    }
+    std::vector<double> e(g.cells(), 0.0);
+    double total = 0;
+    for (int c : all) total += (e[c] = coarse[c]);
+    e.back() = std::max(0.0, 1.0 - total);
+    return e;
 }
 
 }  // namespace mcrt::test

@@ -141,58 +141,16 @@ struct HemisphereGrid {
     }
 };
 
-// ∫ pdf_w over each cell by the midpoint rule on m × m points weighted by sinθ; cells where the
-// pdf varies by more than 10% between their points (a grazing view's lobe is a thin sliver at
-// the horizon, Jacobian 4 wo·h) again on fine × fine points. The last entry is what is left.
+// The expected fraction of samples in each cell (chi2.h, expected_cell_fractions).
 std::vector<double> expected_fractions(const TestMaterial& mat, dvec3 wo, const HemisphereGrid& g,
                                        int m, int fine) {
-    auto integrate = [&](const std::vector<int>& cells, int q, std::vector<double>* spread) {
+    return expected_cell_fractions(g, m, fine, [&](const std::vector<dvec3>& directions) {
         std::vector<cl_float4> w;
-        std::vector<double> weight;
-        w.reserve(cells.size() * q * q);
-        for (int cell : cells) {
-            int it = cell / g.np, ip = cell % g.np;
-            for (int a = 0; a < q; ++a)
-                for (int b = 0; b < q; ++b) {
-                    double t = (it + (a + 0.5) / q) * g.dt(), p = (ip + (b + 0.5) / q) * g.dp();
-                    w.push_back(f4(g.direction(t, p)));
-                    weight.push_back(std::sin(t) * g.dt() * g.dp() / (q * q));
-                }
-        }
+        for (const dvec3& d : directions) w.push_back(f4(d));
         std::vector<float> pdf;
         evaluate(mat, wo, w, &pdf, nullptr);
-        std::vector<double> out(cells.size(), 0.0);
-        if (spread) spread->assign(cells.size(), 0.0);
-        for (size_t c = 0; c < cells.size(); ++c) {
-            double lo = 1e300, hi = 0;
-            for (int k = 0; k < q * q; ++k) {
-                size_t j = c * q * q + k;
-                out[c] += pdf[j] * weight[j];
-                lo = std::min(lo, double(pdf[j]));
-                hi = std::max(hi, double(pdf[j]));
-            }
-            if (spread) (*spread)[c] = hi > 0 ? (hi - lo) / hi : 0.0;
-        }
-        return out;
-    };
-    std::vector<int> all(g.nt * g.np);
-    std::iota(all.begin(), all.end(), 0);
-    std::vector<double> spread;
-    std::vector<double> coarse = integrate(all, m, &spread);
-    std::vector<int> refine;
-    for (int c : all)
-        if (spread[c] > 0.1) refine.push_back(c);
-    for (size_t begin = 0; begin < refine.size(); begin += 256) {
-        std::vector<int> part(refine.begin() + begin,
-                              refine.begin() + std::min(refine.size(), begin + 256));
-        std::vector<double> v = integrate(part, fine, nullptr);
-        for (size_t k = 0; k < part.size(); ++k) coarse[part[k]] = v[k];
-    }
-    std::vector<double> e(g.cells(), 0.0);
-    double total = 0;
-    for (int c : all) total += (e[c] = coarse[c]);
-    e.back() = std::max(0.0, 1.0 - total);
-    return e;
+        return pdf;
+    });
 }
 
 void bsdf_chi2(const TestMaterial& mat, double view_degrees, cl_uint seed) {
