@@ -13,9 +13,12 @@
 #include "chi2.h"
 #include "common/error.h"
 #include "image/image.h"
+#include "process_support.h"
 #include "scene/environment_map.h"
+#include "test_support.h"
 
 using namespace mcrt;
+using namespace mcrt::test;
 
 namespace {
 
@@ -127,7 +130,7 @@ TEST_CASE("environment samples follow their pdf: pdf integrates to 1, chi2 over 
     for (size_t k = 0; k < expected.size(); ++k) {
         expected[k] = n * (double(dist.cdf[k + 1]) - double(dist.cdf[k]));
     }
-    const test::Chi2 chi2 = test::chi2_test("environment texels", observed, expected, 1e-3);
+    const Chi2 chi2 = chi2_test("environment texels", observed, expected, 1e-3);
     CHECK(chi2.statistic < chi2.critical);
 }
 
@@ -230,4 +233,27 @@ TEST_CASE("hostile environment maps: one InputError naming the file", "[environm
     require_refused(write_hdr("zero.hdr", "-Y 2 +X 2", 4, 0, 0), "every texel");
     require_refused(scratch("missing.hdr"), "cannot open");
     require_refused(write_map_exr("named.png", 1, 1, 1.0f), ".exr or .hdr");
+}
+
+TEST_CASE("make_sky_maps.py writes maps the reader takes, a sun 10^4 times its sky", "[environment]") {
+    const char* python = "/usr/bin/python3";
+    if (!std::filesystem::exists(python)) skip_test(std::string(python) + " not found");
+    const std::filesystem::path dir = std::filesystem::path(scratch("sky-maps"));
+    std::filesystem::create_directories(dir);
+    const ProcessResult run = run_process(
+        python, {std::string(MCRT_SOURCE_DIR) + "/scripts/scenes/make_sky_maps.py", dir.string()},
+        dir, 60.0);
+    if (run.exit_code != 0 && run.err.find("No module named") != std::string::npos) {
+        skip_test("python3 lacks numpy");
+    }
+    REQUIRE(run.exit_code == 0);
+    const auto sun = load_environment_map((dir / "sun-sky.hdr").string(), 1.0f);
+    CHECK(sun.width == 512);
+    CHECK(sun.height == 256);
+    const float brightest = *std::max_element(sun.rgb.begin(), sun.rgb.end());
+    const float zenith_blue = sun.rgb[2];  // row 0: the zenith's blue
+    CHECK(brightest / zenith_blue > 5e3);
+    const auto overcast = load_environment_map((dir / "overcast.hdr").string(), 1.0f);
+    // CIE overcast: the zenith row (1 + 2cos θ)/3 at θ = π/64, within RGBE's 1/256.
+    CHECK(overcast.rgb[0] == Approx((1 + 2 * std::cos(kPi / 64)) / 3).epsilon(1.0 / 128));
 }
