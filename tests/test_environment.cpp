@@ -94,6 +94,15 @@ TEST_CASE("texel solid angles cover the sphere", "[environment]") {
     }
 }
 
+TEST_CASE("environment power: pi r^2 times radiance over the sphere", "[environment]") {
+    const auto sky = uniform_environment_map({2.0f, 2.0f, 2.0f});
+    CHECK(environment_power(sky, 3.0) == Approx(4 * kPi * kPi * 9 * 2.0).epsilon(1e-12));
+    // A band of rows: π r² Σ_rows L_j · 2π (cos θ_j − cos θ_{j+1}).
+    const EnvironmentMap band = band_map(8, 4, 1, 1, 10.0f, 0.0f);
+    const double omega = 2 * kPi * (std::cos(kPi / 4) - std::cos(kPi / 2));
+    CHECK(environment_power(band, 1.0) == Approx(kPi * 10.0 * omega).epsilon(1e-6));
+}
+
 TEST_CASE("environment samples follow their pdf: pdf integrates to 1, chi2 over texels",
           "[environment]") {
     EnvironmentMap map = band_map(16, 8, 2, 3, 50.0f, 1.0f);

@@ -176,6 +176,18 @@ double environment_luminance(const float* rgb) {
     return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
 }
 
+double environment_power(const EnvironmentMap& map, double scene_radius) {
+    double integral = 0;
+    for (int j = 0; j < map.height; ++j) {
+        double row = 0;
+        for (int i = 0; i < map.width; ++i) {
+            row += environment_luminance(&map.rgb[3 * (size_t(j) * map.width + i)]);
+        }
+        integral += row * texel_solid_angle(map.width, map.height, j);
+    }
+    return kPi * scene_radius * scene_radius * integral;
+}
+
 EnvironmentDistribution build_environment_distribution(const EnvironmentMap& map) {
     std::vector<double> weights(size_t(map.width) * map.height);
     for (int j = 0; j < map.height; ++j) {

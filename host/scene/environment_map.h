@@ -42,6 +42,11 @@ double texel_solid_angle(int width, int height, int row);
 // Rec. 709 luminance, the weight of a texel's radiance.
 double environment_luminance(const float* rgb);
 
+// Power for light selection: π r² ∫ Y(L(ω)) dω over the sphere, the light that crosses the disk of
+// the scene's bounding sphere of radius r (PBRT 4th ed. §12.5.2, ImageInfiniteLight::Phi, with the
+// texels' exact solid angles); a uniform sky of luminance Y gives 4π² r² Y.
+double environment_power(const EnvironmentMap& map, double scene_radius);
+
 // Sampling distribution: one CDF over all W·H texels ∝ luminance × texel solid angle, on the
 // 2^-24 grid (build_cdf), so that cdf[k+1] − cdf[k] is exactly the probability of texel k.
 struct EnvironmentDistribution {
