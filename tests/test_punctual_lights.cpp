@@ -145,3 +145,18 @@ TEST_CASE("Hostile punctual lights fail with one line naming the light", "[punct
         CHECK(message.find('\n') == std::string::npos);
     }
 }
+
+TEST_CASE("punctual_power: 4πI, 2πI(1 − (cos i + cos o)/2) and πr²E", "[punctual]") {
+    const Loaded loaded = load(gltf_with(
+        R"({"type":"point","color":[0,1,0],"intensity":2},)"
+        R"({"type":"spot","intensity":3,"spot":{"innerConeAngle":0.2,"outerConeAngle":0.4}},)"
+        R"({"type":"directional","intensity":5})",
+        {light_node(0), light_node(1), light_node(2)}));
+    REQUIRE(loaded.scene.punctual_lights.size() == 3);
+    const double pi = glm::pi<double>();
+    CHECK(mcrt::punctual_power(loaded.scene.punctual_lights[0], 1.0) ==
+          Approx(4.0 * pi * 0.7152 * 2.0));
+    CHECK(mcrt::punctual_power(loaded.scene.punctual_lights[1], 1.0) ==
+          Approx(2.0 * pi * 3.0 * (1.0 - 0.5 * (std::cos(0.2) + std::cos(0.4)))).epsilon(1e-6));
+    CHECK(mcrt::punctual_power(loaded.scene.punctual_lights[2], 2.0) == Approx(pi * 4.0 * 5.0));
+}

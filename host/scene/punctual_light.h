@@ -2,6 +2,7 @@
 // lights, in world space, with their emission in mcrt's units (DESIGN.md "Punctual lights").
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 
@@ -32,6 +33,23 @@ inline double spot_attenuation(const PunctualLight& light, double cos_theta) {
     double t = cos_theta * double(light.spot_scale) + double(light.spot_offset);
     t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
     return t * t;
+}
+
+// The power a light selection weighs a punctual light by, from the luminance of its intensity
+// (Rec. 709): 4πI for a point light, 2πI(1 − (cos inner + cos outer)/2) for a spot (pbrt-v4's
+// SpotLight::Phi), πr²E for a directional light over the disk of the scene's bounding sphere of
+// radius `bounding_radius` (pbrt-v4's DistantLight::Phi).
+inline double punctual_power(const PunctualLight& light, double bounding_radius) {
+    const double pi = 3.14159265358979323846;
+    const double y = 0.2126 * light.intensity.r + 0.7152 * light.intensity.g +
+                     0.0722 * light.intensity.b;
+    switch (light.type) {
+    case PunctualType::Point: return 4.0 * pi * y;
+    case PunctualType::Spot:
+        return 2.0 * pi * y * (1.0 - 0.5 * (double(light.cos_inner) + double(light.cos_outer)));
+    case PunctualType::Directional: return pi * bounding_radius * bounding_radius * y;
+    }
+    return 0.0;
 }
 
 }  // namespace mcrt
