@@ -22,8 +22,11 @@ std::string gltf_with(const std::string& lights, const std::vector<std::string>&
         roots += (i ? "," : "") + std::to_string(i);
     }
     return R"({"asset":{"version":"2.0"},"extensionsUsed":["KHR_lights_punctual"],)"
-           R"("extensions":{"KHR_lights_punctual":{"lights":[)" + lights + "]}},"
-           R"("nodes":[)" + node_list + R"(],"scenes":[{"nodes":[)" + roots + R"(]}],"scene":0})";
+           R"("extensions":{"KHR_lights_punctual":{"lights":[)" +
+           lights +
+           "]}},"
+           R"("nodes":[)" +
+           node_list + R"(],"scenes":[{"nodes":[)" + roots + R"(]}],"scene":0})";
 }
 
 std::string light_node(int light, const std::string& transform = "") {
@@ -57,9 +60,9 @@ std::string load_error(const std::string& json) {
 }  // namespace
 
 TEST_CASE("A point light: position from its node, color × intensity", "[punctual]") {
-    const Loaded loaded = load(gltf_with(
-        R"({"type":"point","color":[1,0.5,0.25],"intensity":8,"name":"bulb"})",
-        {light_node(0, R"("translation":[1,2,3],"scale":[5,5,5])")}));
+    const Loaded loaded =
+        load(gltf_with(R"({"type":"point","color":[1,0.5,0.25],"intensity":8,"name":"bulb"})",
+                       {light_node(0, R"("translation":[1,2,3],"scale":[5,5,5])")}));
     REQUIRE(loaded.scene.punctual_lights.size() == 1);
     const mcrt::PunctualLight& light = loaded.scene.punctual_lights[0];
     CHECK(light.type == mcrt::PunctualType::Point);
@@ -73,9 +76,9 @@ TEST_CASE("A point light: position from its node, color × intensity", "[punctua
 TEST_CASE("A spot light: its axis is the node's −Z, its falloff the extension's", "[punctual]") {
     // Rotated −90° about +X: −Z turns to −Y (quaternion (−sin 45°, 0, 0, cos 45°)).
     const double inner = 0.3, outer = 0.6;
-    const Loaded loaded = load(gltf_with(
-        R"({"type":"spot","spot":{"innerConeAngle":0.3,"outerConeAngle":0.6}})",
-        {light_node(0, R"("rotation":[-0.7071067811865476,0,0,0.7071067811865476])")}));
+    const Loaded loaded = load(
+        gltf_with(R"({"type":"spot","spot":{"innerConeAngle":0.3,"outerConeAngle":0.6}})",
+                  {light_node(0, R"("rotation":[-0.7071067811865476,0,0,0.7071067811865476])")}));
     REQUIRE(loaded.scene.punctual_lights.size() == 1);
     const mcrt::PunctualLight& light = loaded.scene.punctual_lights[0];
     CHECK(light.type == mcrt::PunctualType::Spot);
@@ -92,10 +95,10 @@ TEST_CASE("A spot light: its axis is the node's −Z, its falloff the extension'
 }
 
 TEST_CASE("A directional light and a shared light: one instance per node", "[punctual]") {
-    const Loaded loaded = load(gltf_with(
-        R"({"type":"directional","intensity":3},{"type":"point","range":10})",
-        {light_node(0), light_node(1, R"("translation":[0,1,0])"),
-         light_node(1, R"("translation":[0,2,0])")}));
+    const Loaded loaded =
+        load(gltf_with(R"({"type":"directional","intensity":3},{"type":"point","range":10})",
+                       {light_node(0), light_node(1, R"("translation":[0,1,0])"),
+                        light_node(1, R"("translation":[0,2,0])")}));
     REQUIRE(loaded.scene.punctual_lights.size() == 3);
     CHECK(loaded.scene.punctual_lights[0].type == mcrt::PunctualType::Directional);
     CHECK(loaded.scene.punctual_lights[0].direction == glm::vec3(0.0f, 0.0f, -1.0f));
@@ -119,7 +122,8 @@ TEST_CASE("Hostile punctual lights fail with one line naming the light", "[punct
     };
     const std::vector<Case> cases = {
         {R"({"type":"point","intensity":-1})", light_node(0), "light 0: intensity -1"},
-        {R"({"type":"point","intensity":1e39})", light_node(0), "light 0: color × intensity is too large"},
+        {R"({"type":"point","intensity":1e39})", light_node(0),
+         "light 0: color × intensity is too large"},
         {R"({"type":"point","color":[1,-0.5,1]})", light_node(0), "light 0: color"},
         {R"({"type":"point","color":[1,1]})", light_node(0), "light 0: color must have 3"},
         {R"({"type":"area"})", light_node(0), "light 0: unknown type \"area\""},

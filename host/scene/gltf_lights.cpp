@@ -2,7 +2,9 @@
 // with their node's transform, checked before they are used.
 #include "scene/gltf_lights.h"
 
+#include <algorithm>
 #include <glm/gtc/constants.hpp>
+#include <limits>
 
 namespace mcrt::gltf {
 
@@ -25,7 +27,8 @@ glm::dvec3 checked_emission(const tinygltf::Light& light, const std::string& ele
                                " must be finite and non-negative");
     }
     const glm::dvec3 emission = color * light.intensity;
-    if (!is_finite(emission) || max_component(emission) > double(std::numeric_limits<float>::max())) {
+    if (!is_finite(emission) ||
+        max_component(emission) > double(std::numeric_limits<float>::max())) {
         diag.fail(element, "color × intensity is too large");
     }
     return emission;
@@ -74,7 +77,8 @@ PunctualLight read_punctual_light(const tinygltf::Model& model, const tinygltf::
     }
     result.intensity = glm::vec3(checked_emission(light, element, diag));
     if (light.range != 0.0) {
-        diag.warn_once("light range", "KHR_lights_punctual range is ignored; lights fall off as 1/d^2");
+        diag.warn_once("light range",
+                       "KHR_lights_punctual range is ignored; lights fall off as 1/d^2");
     }
 
     // The light sits at the node's origin and points down its −Z; the node's scale does not

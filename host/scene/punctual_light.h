@@ -4,9 +4,8 @@
 
 #include <cmath>
 #include <cstdint>
-#include <string>
-
 #include <glm/glm.hpp>
+#include <string>
 
 namespace mcrt {
 
@@ -16,11 +15,11 @@ enum class PunctualType : uint8_t { Point, Spot, Directional };
 // intensity: the units of mcrt's emission × m², so candela goes with nits) from `position`; a
 // directional light delivers `intensity` as irradiance on a surface facing it (lux with nits).
 struct PunctualLight {
-    std::string name;        // the light's, else the node's, else "light N"
+    std::string name;  // the light's, else the node's, else "light N"
     PunctualType type = PunctualType::Point;
-    glm::vec3 position{0.0f};           // world; unused for a directional light
+    glm::vec3 position{0.0f};                // world; unused for a directional light
     glm::vec3 direction{0.0f, 0.0f, -1.0f};  // world, unit: where the light points (node's −Z)
-    glm::vec3 intensity{1.0f};          // color × intensity, every component ≥ 0 and finite
+    glm::vec3 intensity{1.0f};               // color × intensity, every component ≥ 0 and finite
     // Spot: attenuation = clamp(cos θ · spot_scale + spot_offset, 0, 1)², θ from `direction`,
     // scale = 1/max(0.001, cos inner − cos outer), offset = −cos outer · scale (the extension's
     // implementation notes). A point or directional light has scale 0, offset 1 (no falloff).
@@ -41,13 +40,15 @@ inline double spot_attenuation(const PunctualLight& light, double cos_theta) {
 // radius `bounding_radius` (pbrt-v4's DistantLight::Phi).
 inline double punctual_power(const PunctualLight& light, double bounding_radius) {
     const double pi = 3.14159265358979323846;
-    const double y = 0.2126 * light.intensity.r + 0.7152 * light.intensity.g +
-                     0.0722 * light.intensity.b;
+    const double y =
+        0.2126 * light.intensity.r + 0.7152 * light.intensity.g + 0.0722 * light.intensity.b;
     switch (light.type) {
-    case PunctualType::Point: return 4.0 * pi * y;
-    case PunctualType::Spot:
-        return 2.0 * pi * y * (1.0 - 0.5 * (double(light.cos_inner) + double(light.cos_outer)));
-    case PunctualType::Directional: return pi * bounding_radius * bounding_radius * y;
+        case PunctualType::Point:
+            return 4.0 * pi * y;
+        case PunctualType::Spot:
+            return 2.0 * pi * y * (1.0 - 0.5 * (double(light.cos_inner) + double(light.cos_outer)));
+        case PunctualType::Directional:
+            return pi * bounding_radius * bounding_radius * y;
     }
     return 0.0;
 }
