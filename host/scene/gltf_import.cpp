@@ -12,6 +12,7 @@
 #include "scene/gltf_diagnostics.h"
 #include "scene/gltf_geometry.h"
 #include "scene/gltf_images.h"
+#include "scene/gltf_lights.h"
 #include "scene/gltf_materials.h"
 #include "scene/gltf_nodes.h"
 #include "scene/gltf_parse.h"
@@ -21,17 +22,12 @@ namespace mcrt {
 
 namespace {
 
-// Skins and KHR_lights_punctual lights are ignored wherever a file holds them (the model or a
-// node): one warning each.
+// Skins are ignored wherever a file holds them (the model or a node): one warning.
 void warn_skins(gltf::Diagnostics& diag) {
     diag.warn_once("skins", "skins are not supported; meshes keep their bind pose");
 }
-void warn_lights(gltf::Diagnostics& diag) {
-    diag.warn_once("lights", "KHR_lights_punctual lights are not supported; ignored");
-}
 
 void warn_unsupported_model_parts(const tinygltf::Model& model, gltf::Diagnostics& diag) {
-    if (!model.lights.empty()) warn_lights(diag);
     if (!model.animations.empty()) {
         diag.warn_once("animations", "animations are not supported; the rest pose is used");
     }
@@ -57,7 +53,11 @@ Scene import_default_scene(const tinygltf::Model& model, const std::string& path
         const std::string element = gltf::element_name("node", static_cast<size_t>(node_index));
         if (node.skin != -1) warn_skins(diag);
         if (!node.weights.empty()) gltf::warn_morph_targets(diag);
-        if (node.extensions.count("KHR_lights_punctual")) warn_lights(diag);
+        const auto light = node.extensions.find("KHR_lights_punctual");
+        if (light != node.extensions.end()) {
+            scene.punctual_lights.push_back(
+                gltf::read_punctual_light(model, light->second, world, node_index, diag));
+        }
         if (node.mesh != -1) {
             const tinygltf::Mesh& mesh =
                 gltf::checked_at(model.meshes, node.mesh, "mesh", element, diag);
@@ -76,6 +76,11 @@ Scene import_default_scene(const tinygltf::Model& model, const std::string& path
         }
     });
     geometry.finish();
+    if (!scene.punctual_lights.empty()) {
+        diag.warn_once("lights", std::to_string(scene.punctual_lights.size()) +
+                                     " KHR_lights_punctual light(s) read; the renderer does not "
+                                     "draw punctual lights yet");
+    }
     gltf::warn_open_volumes(scene, diag);
     for (const tinygltf::Camera& camera : model.cameras) scene.gltf_camera_types.push_back(camera.type);
     // The images the used materials' texture slots name, once the walk has found them all.

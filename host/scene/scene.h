@@ -10,6 +10,8 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/punctual_light.h"
+
 namespace mcrt {
 
 // How a texture's coordinates outside [0, 1] are read, per axis (glTF 2.0 "Samplers"; default
@@ -142,6 +144,8 @@ struct Scene {
     // primitive has no TANGENT.
     std::vector<glm::vec3> normals;
     std::vector<glm::vec4> tangents;
+    // KHR_lights_punctual lights, one per node that holds one, in default-scene traversal order.
+    std::vector<PunctualLight> punctual_lights;
 
     bool textured() const { return !texcoords.empty(); }
 
