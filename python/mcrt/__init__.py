@@ -129,9 +129,17 @@ class Context:
     """The devices of a render session, with the programs and scenes kept on them.
 
     device: as `mcrt render --device`, one spec or a list (an index from mcrt.devices(),
-    cpu, gpu, all, or a platform such as pocl); None: the first device."""
+    cpu, gpu, all, or a platform such as pocl); None: the first device.
+    isolated: render in a supervised child process (a user's estimator that hangs or crashes
+    raises DeviceError instead of ending Python); see docs/PYTHON.md."""
 
-    def __init__(self, device=None):
+    def __new__(cls, device=None, isolated=False):
+        if cls is Context and isolated:
+            from ._isolated_api import IsolatedContext
+            return IsolatedContext(device)
+        return super().__new__(cls)
+
+    def __init__(self, device=None, isolated=False):
         if device is None:
             specs = []
         elif isinstance(device, (str, int)) and not isinstance(device, bool):

@@ -8,7 +8,11 @@ times and the ratios (docs/PYTHON.md).
 
     PYTHONPATH=build/python scripts/tools/sweep_bench.py [--scene S.gltf] [--mcrt build/mcrt]
         [--size 64] [--spp 4] [--estimators light-area,light-solid-angle,bsdf,mis]
-        [--selections uniform,power,tree] [--repeats 3]
+        [--selections uniform,power,tree] [--repeats 3] [--set OPTION=VALUE ...]
+
+--set passes one more `mcrt render` option to every render of the three (e.g. --set sky=1
+--set look-from=9.2,1.44,-0.32): the command gets `--OPTION VALUE`, the module the keyword
+OPTION with `_` for `-` and the value as a number or a tuple of numbers.
 """
 
 import argparse
@@ -40,14 +44,34 @@ def parse():
     parser.add_argument("--estimators", default="light-area,light-solid-angle,bsdf,mis")
     parser.add_argument("--selections", default="uniform,power,tree")
     parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--set", action="append", default=[], metavar="OPTION=VALUE")
     parser.add_argument("--child", help=argparse.SUPPRESS)  # the new process: its images' file
     return parser.parse_args()
+
+
+def number(text):
+    return int(text) if text.lstrip("-").isdigit() else float(text)
+
+
+def extra_keywords(args):
+    keywords = {}
+    for item in args.set:
+        option, value = item.split("=", 1)
+        values = tuple(number(v) for v in value.split(","))
+        keywords[option.replace("-", "_")] = values if len(values) > 1 else values[0]
+    return keywords
+
+
+def extra_options(args):
+    return [part for item in args.set for part in ("--" + item.split("=", 1)[0],
+                                                    item.split("=", 1)[1])]
 
 
 def sweep(scene, args):
     variants = [(e, s) for e in args.estimators.split(",") for s in args.selections.split(",")]
     return [scene.render(estimator=e, light_select=s, width=args.size, height=args.size,
-                         spp=args.spp, max_depth=2).image.copy() for e, s in variants]
+                         spp=args.spp, max_depth=2, **extra_keywords(args)).image.copy()
+            for e, s in variants]
 
 
 def main():
@@ -71,7 +95,7 @@ def main():
             subprocess.run([args.mcrt, "render", args.scene, "--out", str(out), "--quiet",
                             "--width", str(args.size), "--height", str(args.size),
                             "--spp", str(args.spp), "--max-depth", "2", "--estimator", e,
-                            "--light-select", s], check=True)
+                            "--light-select", s] + extra_options(args), check=True)
             channels = read_exr(str(out))
             images.append(np.stack([channels[c] for c in ("R", "G", "B")], axis=-1))
         return images
