@@ -134,6 +134,7 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
     hit.t = t_max;
     hit.b1 = hit.b2 = 0.0f;
     hit.lane = MCRT_NO_HIT;
+    uint hit_index = UINT_MAX; /* the winner's triangle index */
 
     BoxRay b = make_box_ray(r);
     PacketRay q = make_packet_ray(r);
@@ -180,26 +181,38 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
                 continue;
             }
         } else {
-            /* A leaf's packets, four triangles per test; within a test the lanes are taken in
-             * leaf order, a later one only if strictly nearer, as one at a time would. */
+            /* A leaf's packets, four triangles per test. The winner is the smallest t, and among
+             * equal t the smallest triangle index, so the hit does not depend on the tree's layout
+             * or the order it is walked in. Once a hit is held, lanes at exactly its t are tested
+             * too (the bound is the next float above it), since one may hold a smaller index. */
             global const TrianglePacket* pk = packets + ref;
+            float t_bound = hit.lane == MCRT_NO_HIT ? hit.t : nextafter(hit.t, MAXFLOAT);
             for (uint k = 0; k < count; k += MCRT_PACKET_WIDTH, ++pk) {
                 float4 t4 = (float4)(0.0f), b1 = (float4)(0.0f), b2 = (float4)(0.0f);
                 uint packet = ref + k / MCRT_PACKET_WIDTH;
-                int4 lanes = intersect_packet(&q, pk, t_min, hit.t, skipped_lanes(&s, packet),
+                int4 lanes = intersect_packet(&q, pk, t_min, t_bound, skipped_lanes(&s, packet),
                                               false, &t4, &b1, &b2);
 #if defined(MCRT_TEXTURES)
                 lanes = alpha_kept_lanes(alpha, packet, lanes, b1, b2);
 #endif
-                /* The nearest hit lane, the first of equals (leaf order, as one triangle at a time
-                 * would take them), by compares instead of a loop over private arrays; taken by
-                 * selects, not a branch on whether any lane hit (which mispredicted). A lane hits
-                 * only nearer than hit.t, so m < hit.t exactly when one does. */
+                /* The nearest hit lane, the smallest triangle index among equals, by compares
+                 * instead of a loop over private arrays; taken by selects, not a branch on
+                 * whether any lane hit (which mispredicted). */
                 float4 tm = select((float4)(MAXFLOAT), t4, lanes);
                 float2 m2 = min(tm.xy, tm.zw);
                 float m = min(m2.x, m2.y);
                 int i = tm.x == m ? 0 : tm.y == m ? 1 : tm.z == m ? 2 : 3;
-                bool nearer = m < hit.t;
+                int4 at_m = lanes & (tm == (float4)(m));
+                uint mi = pk->index[i];
+                /* Ties (two lanes at m, or m at the held t) are rare: a branch that is almost
+                 * never taken, where the index compares on every packet cost 10-20%. */
+                if (-(at_m.x + at_m.y + at_m.z + at_m.w) > 1) {
+                    uint4 idx = select((uint4)(UINT_MAX), vload4(0, pk->index), as_uint4(at_m));
+                    uint2 i2 = min(idx.xy, idx.zw);
+                    mi = min(i2.x, i2.y);
+                    i = idx.x == mi ? 0 : idx.y == mi ? 1 : idx.z == mi ? 2 : 3;
+                }
+                bool nearer = m < hit.t || (m == hit.t && any(lanes) && mi < hit_index);
                 float hb1 = i == 0 ? b1.x : i == 1 ? b1.y : i == 2 ? b1.z : b1.w;
                 float hb2 = i == 0 ? b2.x : i == 1 ? b2.y : i == 2 ? b2.z : b2.w;
                 uint lane = MCRT_PACKET_WIDTH * packet + (uint)i;
@@ -207,13 +220,16 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
                 hit.b1 = nearer ? hb1 : hit.b1;
                 hit.b2 = nearer ? hb2 : hit.b2;
                 hit.lane = nearer ? lane : hit.lane;
+                hit_index = nearer ? mi : hit_index;
+                t_bound = nextafter(hit.t, MAXFLOAT);
             }
         }
-        /* Pop, skipping children entered beyond the closest hit found since they were pushed. */
+        /* Pop, skipping children entered beyond the closest hit found since they were pushed; a
+         * child entered exactly at the hit's t is visited, as it may hold a smaller index there. */
         for (;;) {
             if (sp == 0) return hit;
             --sp;
-            if (stack_t[sp] < hit.t) break;
+            if (stack_t[sp] <= hit.t) break;
         }
         ref = stack_ref[sp];
         count = stack_count[sp];
