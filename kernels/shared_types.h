@@ -323,7 +323,7 @@ typedef struct {
 
 /* The per-render values of the render kernel, passed by value as its last argument, 80 bytes.
  * Values that change per render or per launch live here, never in -D options, so they never
- * trigger a rebuild (STYLE.md). */
+ * trigger a rebuild: a sweep over them reuses one program. */
 typedef struct {
     float4 sky;         /* .xyz uniform sky radiance (ambient estimators, or the sky light);
                            .w the probability that the light strategies choose the sky light,
