@@ -33,13 +33,28 @@ BatchResult RemoteWorker::run(const WorkItem& item) {
     // An item takes about 150 ms: a rank silent for minutes is dead or hung. Only an MPI job
     // that outlives a process (mpirun --enable-recovery) lets rank 0 get this far.
     const double timeout = std::max(mpi::silence_timeout(), 20 * last_run_);
-    std::optional<wire::Bytes> received =
-        mpi::receive_bytes_within(rank_, mpi::result_tag(slot_), timeout);
+    // Waited for in slices, so that a stop (stopping()) cuts the wait short.
+    std::optional<wire::Bytes> received;
+    bool cut_by_stop = false;
+    for (;;) {
+        const auto now = std::chrono::steady_clock::now();
+        const double waited = std::chrono::duration<double>(now - start).count();
+        const int64_t deadline = stop_deadline_.load();
+        cut_by_stop = deadline != 0 && now.time_since_epoch().count() >= deadline;
+        if (waited >= timeout || cut_by_stop) break;
+        received = mpi::receive_bytes_within(rank_, mpi::result_tag(slot_),
+                                             std::min(0.25, timeout - waited));
+        if (received) break;
+    }
     if (!received) {
         failed_ = true;
         traffic_->lost = true;
+        const double waited =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         throw RuntimeError("rank " + std::to_string(rank_) + " sent nothing for " +
-                           std::to_string(int(timeout)) + " s and is taken for dead");
+                           std::to_string(int(waited)) + " s" +
+                           (cut_by_stop ? " after the render stopped" : "") +
+                           " and is taken for dead");
     }
     const wire::Bytes& reply = *received;
     double round_trip =
@@ -56,6 +71,13 @@ BatchResult RemoteWorker::run(const WorkItem& item) {
     pending_bytes_ = request.size() + reply.size();
     pending_overhead_ = std::max(0.0, round_trip - m.seconds_run);
     return std::move(m.result);
+}
+
+void RemoteWorker::stopping(double seconds) {
+    const auto deadline = std::chrono::steady_clock::now() +
+                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                              std::chrono::duration<double>(seconds));
+    stop_deadline_.store(deadline.time_since_epoch().count());
 }
 
 void RemoteWorker::commit_report() {

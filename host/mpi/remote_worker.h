@@ -2,6 +2,7 @@
 // device; each is sent to that rank, which renders it and sends back its sums (built with MPI).
 #pragma once
 
+#include <atomic>
 #include <string>
 
 #include "render/render_worker.h"
@@ -29,6 +30,9 @@ class RemoteWorker : public RenderWorker {
     // mpi::silence_timeout() (and the whole rank is lost: it is not told to stop).
     BatchResult run(const WorkItem& item) override;
     void commit_report() override;
+    // After a stop an item is waited for `seconds` more at most, so that a rank that died during
+    // the stop is taken for dead before the supervisor's grace period ends.
+    void stopping(double seconds) override;
 
   private:
     int rank_, slot_;
@@ -38,6 +42,8 @@ class RemoteWorker : public RenderWorker {
     uint64_t pending_samples_ = 0, pending_bytes_ = 0;
     double pending_busy_ = 0, pending_overhead_ = 0;
     double last_run_ = 0;  // the last item's wall time on that rank
+    // steady_clock nanoseconds after which an item is not waited for (stopping()); 0: none.
+    std::atomic<int64_t> stop_deadline_{0};
 };
 
 }  // namespace mcrt

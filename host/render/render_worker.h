@@ -38,6 +38,11 @@ class RenderWorker {
         return run(item);
     }
 
+    // The render has stopped (time limit or interrupt): an item still in flight that has not
+    // returned within `seconds` may be given up. Called from the render's own thread; a local
+    // device cannot be cut short and ignores it, another rank's device does not wait longer.
+    virtual void stopping(double /*seconds*/) {}
+
     DeviceReport report;
 
   private:

@@ -216,6 +216,9 @@ RenderResult render_with_workers(const std::vector<const DeviceContext*>& device
         if (!result.stopped_by.empty() && stopped_at == 0) {
             stopped_at = elapsed;
             queue.stop();  // hand-out stops after the first chunk row; in-flight work drains
+            // Another rank's device that does not answer within the grace is taken for dead,
+            // before the supervisor's own grace for a launch ends (kSupervisorGraceSeconds).
+            for (auto& w : workers) w->stopping(kStopGraceSeconds);
         }
         if (stopped_at > 0 && elapsed - stopped_at > kStopGraceSeconds) {
             std::lock_guard<std::mutex> lock(acc_mutex);
