@@ -24,7 +24,12 @@ Mitsuba 3 scene and renders it:
              material to Mitsuba's `principled` (base_color, metallic, roughness, specular =
              0.5 × specularFactor: F0 0.04 × specularFactor as glTF's), an approximation
              (Mitsuba's is Burley's 2015 Disney BRDF: a retro-reflective diffuse lobe, not
-             glTF's Lambertian base), for textured scenes such as Sponza;
+             glTF's Lambertian base), for textured scenes such as Sponza. Glass
+             (KHR_materials_transmission bounding a KHR_materials_volume) is `dielectric`
+             (roughness 0) or `roughdielectric` with the material's ior, the transmission tinted
+             by the base colour, blended with a Lambertian base where transmissionFactor < 1,
+             an absorbing volume an interior `homogeneous` medium under `volpath`; thin-walled
+             glass has no Mitsuba equivalent and is refused (MaterialConversion.glass_bsdf);
   textures   (glTF 2.0 "Texture Data", "Metallic-Roughness Material", "Additional Textures")
              each slot becomes a `bitmap` with raw = true holding the values mcrt computes
              before filtering: baseColor and emissive texels sRGB-decoded (IEC 61966-2-1) and
@@ -590,6 +595,7 @@ class MaterialConversion:
         self.alpha = pbr.get("baseColorFactor", [1, 1, 1, 1])[3]
         self.alpha_mode = self.material.get("alphaMode", "OPAQUE")
         self.cutoff = self.material.get("alphaCutoff", 0.5) if self.alpha_mode == "MASK" else None
+        self.interior = None  # an absorbing glass volume's medium (glass_bsdf)
 
     @property
     def has_normal_map(self):
@@ -637,6 +643,10 @@ class MaterialConversion:
         roughness = pbr.get("roughnessFactor", 1.0)
         specular_ext = self.material.get("extensions", {}).get("KHR_materials_specular", {})
         specular = specular_ext.get("specularFactor", 1.0)
+        transmission = self.material.get("extensions", {}).get(
+            "KHR_materials_transmission", {}).get("transmissionFactor", 0.0)
+        if transmission > 0.0:
+            return self.glass_bsdf(base, diffuse, metallic, roughness, specular, transmission)
         if metallic == 0.0 and specular == 0.0:
             return diffuse
         mr = self.slots.get("metallicRoughness")
@@ -665,6 +675,58 @@ class MaterialConversion:
             "no Mitsuba 3 equivalent; use --materials lambert or the approximate --materials "
             "principled" % (self.name, what))
 
+    def glass_bsdf(self, base, diffuse, metallic, roughness, specular, transmission):
+        """mcrt's glass (docs/MATERIALS.md "Glass") as Mitsuba's `dielectric` (roughness 0:
+        mcrt's pair of delta lobes) or `roughdielectric` (GGX, alpha = max(roughness^2, 1e-3),
+        visible normals; both Walter et al. 2007), int_ior = KHR_materials_ior's ior, ext_ior 1,
+        transmission tinted by the base colour (specular_transmittance), reflection not;
+        transmissionFactor T < 1 blends it with the Lambertian base (`blendbsdf`, weight T),
+        the extension's mix. Only a volume (KHR_materials_volume thicknessFactor > 0) has an
+        equivalent: mcrt's thin-walled surface is one interface that light passes straight
+        through, Mitsuba's `thindielectric` a slab of two. Absorption (attenuationColor at
+        attenuationDistance) is the interior `homogeneous` medium of sigma_t = -ln(c)/d and
+        albedo 0, Beer-Lambert as mcrt's (set_media() turns the integrator into `volpath`)."""
+        ext = self.material.get("extensions", {})
+        if metallic != 0.0:
+            raise mcrt_run.ScriptError("%s: glass mixed with metal (metallic %g) has no Mitsuba 3 "
+                                       "equivalent here" % (self.name, metallic))
+        if "KHR_materials_ior" in ext:
+            ior = ext["KHR_materials_ior"].get("ior", 1.5)
+        else:
+            ior = 1.5
+        if not (1.0 <= ior <= 1e4):  # 0 is the specular-glossiness mode; below 1 mcrt warns
+            raise mcrt_run.ScriptError("%s: ior %g: mcrt reads it specially (docs/MATERIALS.md "
+                                       "\"Bad input\"); no conversion" % (self.name, ior))
+        volume = ext.get("KHR_materials_volume", {})
+        if not volume.get("thicknessFactor", 0.0) > 0.0:
+            raise mcrt_run.ScriptError(
+                "%s: thin-walled glass (no KHR_materials_volume thickness) is one interface in "
+                "mcrt, light passing straight through; Mitsuba 3's thindielectric is a slab of "
+                "two interfaces: no equivalent" % self.name)
+        if "transmissionTexture" in ext.get("KHR_materials_transmission", {}):
+            warn("%s: transmissionTexture is not read (as mcrt)" % self.name)
+        glass = {"type": "dielectric", "int_ior": float(ior), "ext_ior": 1.0,
+                 "specular_transmittance": base}
+        if roughness > 0.0:
+            glass = {"type": "roughdielectric", "distribution": "ggx", "int_ior": float(ior),
+                     "ext_ior": 1.0, "alpha": max(roughness * roughness, 1e-3),
+                     "sample_visible": True, "specular_transmittance": base}
+        distance = volume.get("attenuationDistance", math.inf)
+        color = volume.get("attenuationColor", [1.0, 1.0, 1.0])
+        if 0.0 < distance < math.inf and any(c < 1.0 for c in color):
+            sigma = [-math.log(max(min(c, 1.0), 1e-30)) / distance for c in color]
+            self.interior = {"type": "homogeneous", "albedo": 0.0,
+                             "sigma_t": {"type": "rgb", "value": sigma}}
+        if transmission < 1.0:
+            if specular != 0.0:
+                raise mcrt_run.ScriptError(
+                    "%s: transmissionFactor %g mixes glass with glTF's dielectric base, which has "
+                    "no Mitsuba 3 equivalent (only a Lambertian base, specularFactor 0, converts)"
+                    % (self.name, transmission))
+            glass = {"type": "blendbsdf", "weight": float(transmission),
+                     "bsdf_0": diffuse, "bsdf_1": glass}
+        return glass
+
     def radiance(self, textures, uv_range):
         """The area emitter's radiance: a constant or a texture."""
         emissive = self.slots.get("emissive")
@@ -692,7 +754,8 @@ def uv_range(slots, uv):
 def integrator(max_depth, rr_depth, emitter_samples=1, bsdf_samples=1, null_surfaces=False):
     """Mitsuba's integrator for mcrt's --max-depth (reflections): `direct` at 1 (emitter_samples
     light and bsdf_samples BSDF samples per pixel sample; 1 and 0 is light sampling alone), else
-    `path`; with null_surfaces (MASK or BLEND materials) `volpath`, max_depth N + 1, whose
+    `path`; with null_surfaces (MASK or BLEND materials, or an absorbing glass volume) `volpath`,
+    max_depth N + 1, whose
     shadow rays pass them (its surface part is `path`'s, a null crossing not counted)."""
     if null_surfaces:
         return {"type": "volpath", "max_depth": max(max_depth, 1) + 1, "rr_depth": rr_depth,
@@ -786,7 +849,12 @@ def mitsuba_scene(mi, gltf, width, height, spp, scratch, max_depth=1, rr_depth=5
                 if radiance is not None:
                     shape["emitter"] = {"type": "area", "radiance": radiance}
                     emitters += 1
+                if conv.interior is not None:
+                    shape["interior"] = conv.interior
                 scene["shape" + name[4:]] = shape
+    if integrator_desc is None and any(c.interior is not None for c in conversions.values()):
+        # An absorbing glass volume: `volpath` attenuates the segments inside it.
+        scene["integrator"] = integrator(max_depth, rr_depth, null_surfaces=True)
     return scene, emitters
 
 
