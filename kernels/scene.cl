@@ -77,7 +77,7 @@ inline float3 bent_normal(const TextureView* tv, global const MaterialTextures* 
 }
 
 /* The material's textures evaluated at the hit (MaterialTextures): base colour and alpha,
- * metallic and roughness, emission, the shading normal. */
+ * metallic and roughness, emission, the shading normal, transmission. */
 inline void apply_textures(const SceneView* scene, uint material, uint lane, float b1, float b2,
                            SurfacePoint* sp) {
     const TextureView* tv = &scene->textures;
@@ -94,6 +94,11 @@ inline void apply_textures(const SceneView* scene, uint material, uint lane, flo
     if (texture_slot_used(&mt->emissive))
         sp->material.emission.xyz *= texture_lookup(tv, &mt->emissive, uv).xyz;
     if (texture_slot_used(&mt->normal)) sp->n = bent_normal(tv, mt, lane, b1, b2, uv, sp);
+#if defined(MCRT_TRANSMISSION)
+    /* KHR_materials_transmission: transmissionTexture's R channel × transmissionFactor. */
+    if (texture_slot_used(&mt->transmission))
+        sp->material.transmission *= texture_lookup(tv, &mt->transmission, uv).x;
+#endif
 }
 
 /* The alpha test of a ray query: the vertex's key mixed with the ray's direction, so that each

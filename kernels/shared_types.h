@@ -269,7 +269,7 @@ typedef struct {
 #define MATERIAL_ALPHA_MASK 1u
 #define MATERIAL_ALPHA_BLEND 2u
 
-/* The textures and alpha of one material, 160 bytes, parallel to the materials. */
+/* The textures and alpha of one material, 192 bytes, parallel to the materials. */
 typedef struct {
     TextureSlot base_color;         /* sRGB: RGB × base_color, A × its alpha */
     TextureSlot metallic_roughness; /* linear: B × metallic, G × roughness */
@@ -284,6 +284,7 @@ typedef struct {
      * the untransformed coordinates, so the texel's x and y are turned back by it. */
     float normal_cos, normal_sin;
     uint pad0;
+    TextureSlot transmission; /* linear: R × transmission (KHR_materials_transmission) */
 } MaterialTextures;
 
 /* One image of the texel data, 16 bytes: its texels, row by row from the top, one RGBA8 texel
@@ -405,12 +406,13 @@ enum RenderArgument {
     FIELD(Light, material, 72) FIELD(Light, surface, 76)                                        \
     TYPE(TextureSlot, 32, 16) FIELD(TextureSlot, m, 0) FIELD(TextureSlot, offset_u, 16)         \
     FIELD(TextureSlot, offset_v, 20) FIELD(TextureSlot, image, 24) FIELD(TextureSlot, mode, 28) \
-    TYPE(MaterialTextures, 160, 16) FIELD(MaterialTextures, base_color, 0)                      \
+    TYPE(MaterialTextures, 192, 16) FIELD(MaterialTextures, base_color, 0)                      \
     FIELD(MaterialTextures, metallic_roughness, 32) FIELD(MaterialTextures, normal, 64)         \
     FIELD(MaterialTextures, emissive, 96) FIELD(MaterialTextures, base_alpha, 128)              \
     FIELD(MaterialTextures, alpha_cutoff, 132) FIELD(MaterialTextures, normal_scale, 136)       \
     FIELD(MaterialTextures, alpha_mode, 140) FIELD(MaterialTextures, roughness, 144)            \
     FIELD(MaterialTextures, normal_cos, 148) FIELD(MaterialTextures, normal_sin, 152)           \
+    FIELD(MaterialTextures, transmission, 160)                                                  \
     TYPE(TextureImageGpu, 16, 4) FIELD(TextureImageGpu, offset, 0)                              \
     FIELD(TextureImageGpu, width, 4) FIELD(TextureImageGpu, height, 8)                          \
     TYPE(TextureHeader, 16, 4) FIELD(TextureHeader, materials, 0)                               \

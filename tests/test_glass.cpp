@@ -231,11 +231,16 @@ TEST_CASE("transmission and volume are read; bad values warn once with a fallbac
         for (const Material& m : s.materials) volume = volume || m.volume;
         CHECK(volume);
     }
-    SECTION("transmissionTexture is not read: one warning") {
-        const Loaded l = load_material(
-            R"("KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": {"index": 0}})");
-        REQUIRE(l.warnings.size() == 1);
-        CHECK(l.warnings[0].find("transmissionTexture") != std::string::npos);
+    SECTION("transmissionTexture: its index is checked, a texture without image is warned about") {
+        // The triangle's file has no textures: index 0 names nothing.
+        CHECK(refusal(R"("KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": {"index": 0}})")
+                  .find("texture") != std::string::npos);
+        CHECK(refusal(R"("KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": {"index": 4294967296}})")
+                  .find("transmissionTexture.index") != std::string::npos);
+        CHECK(refusal(R"("KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": {"texCoord": 0}})")
+                  .find("transmissionTexture.index: required") != std::string::npos);
+        CHECK(refusal(R"("KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": 3})")
+                  .find("transmissionTexture") != std::string::npos);
     }
     SECTION("refused: non-numbers, a negative thickness, a malformed colour") {
         CHECK(refusal(R"("KHR_materials_transmission": {"transmissionFactor": "all"})")
@@ -808,5 +813,70 @@ TEST_CASE("a smooth glass slab over a Lambertian floor under the sky: the floor'
         check_unbiased(r, exact, std::string("slab, ") + estimator);
         CHECK(r.non_finite_pixels == 0);
         for (int c = 0; c < 3; ++c) CHECK(r.standard_error[c] < 0.01 * exact[c]);  // not vacuous
+    }
+}
+
+TEST_CASE("transmissionTexture scales transmissionFactor by its R channel", "[glass][textures]") {
+    // A thin smooth pane over a floor under the sky, seen from above. A pane of factor 1 whose
+    // 1×1 texture holds R = 128 must render as an untextured pane of factor 128/255, and one whose
+    // texel is R = 0 as an opaque one (factor 0); the two untextured panes differ by far more than
+    // the renders' noise, so the check can fail.
+    auto pane_scene = [](float factor, int texel) {
+        Scene scene;
+        const float w = 1000.0f;
+        uint32_t floor = add_material(scene, glm::vec3(0.5f, 0.7f, 0.3f));
+        add_quad(scene, {-w, 0, -w}, {-w, 0, w}, {w, 0, w}, {w, 0, -w}, floor);
+        Glass g = rough(0.0, false, true, "pane");
+        g.transmission = factor;
+        scene.materials.push_back(g.scene_material());
+        const uint32_t pane = uint32_t(scene.materials.size() - 1);
+        add_quad(scene, {-w, 0.5f, -w}, {-w, 0.5f, w}, {w, 0.5f, w}, {w, 0.5f, -w}, pane);
+        if (texel >= 0) {
+            TextureImage image;
+            image.name = "transmission";
+            image.width = image.height = 1;
+            image.rgba = {uint8_t(texel), 0, 0, 255};
+            scene.images.push_back(image);
+            TextureRef& ref = scene.materials[pane].transmission_texture;
+            ref.image = 0;
+            ref.linear = false;
+            scene.texcoords.assign(scene.positions.size(), glm::vec4(0.5f, 0.5f, 0.0f, 0.0f));
+        }
+        return scene;
+    };
+    Camera camera = looking_down(glm::vec3(0.0f, 1.0f, 0.0f), glm::radians(30.0f));
+    DeviceContext device = first_device();
+    RenderSettings settings;
+    settings.width = 8;
+    settings.height = 8;
+    settings.spp = 64;
+    settings.sky = glm::vec3(1.0f);
+    settings.sky_light = true;
+    settings.max_depth = 16;
+    settings.rr_depth = 16;
+    settings.estimator = "mis";
+    auto renders = [&](const Scene& scene) {
+        return independent_renders(device, gpu_scene_for(scene, camera, settings), settings, 10, 1300);
+    };
+    auto agree = [](const Renders& a, const Renders& b, const std::string& what) {
+        INFO(what << ": (" << a.mean.x << ", " << a.mean.y << ", " << a.mean.z << ") against ("
+                  << b.mean.x << ", " << b.mean.y << ", " << b.mean.z << ")");
+        CHECK(a.nan_samples == 0);
+        for (int c = 0; c < 3; ++c) {
+            const double se = std::sqrt(a.standard_error[c] * a.standard_error[c] +
+                                        b.standard_error[c] * b.standard_error[c]);
+            CHECK(std::abs(a.mean[c] - b.mean[c]) <= 4.5 * se);
+        }
+    };
+    const Renders half_textured = renders(pane_scene(1.0f, 128));
+    const Renders half = renders(pane_scene(128.0f / 255.0f, -1));
+    const Renders none_textured = renders(pane_scene(1.0f, 0));
+    const Renders none = renders(pane_scene(0.0f, -1));
+    agree(half_textured, half, "factor 1 × texel 128/255 against factor 128/255");
+    agree(none_textured, none, "factor 1 × texel 0 against factor 0");
+    for (int c = 0; c < 3; ++c) {
+        const double se = std::sqrt(half.standard_error[c] * half.standard_error[c] +
+                                    none.standard_error[c] * none.standard_error[c]);
+        CHECK(std::abs(half.mean[c] - none.mean[c]) > 20.0 * se);  // not vacuous
     }
 }

@@ -67,6 +67,7 @@ std::vector<uint32_t> texture_words(const Scene& scene) {
         t.metallic_roughness = texture_slot(m.metallic_roughness_texture);
         t.normal = texture_slot(m.normal_texture);
         t.emissive = texture_slot(m.emissive_texture);
+        t.transmission = texture_slot(m.transmission_texture);
         t.base_alpha = m.alpha;
         t.alpha_cutoff = m.alpha_cutoff;
         t.normal_scale = m.normal_scale;
@@ -156,7 +157,8 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
             g.attenuation = to_float4(glm::vec3(volume_attenuation(m)));
         }
         const bool slots = m.base_color_texture.used() || m.metallic_roughness_texture.used() ||
-                           m.normal_texture.used() || m.emissive_texture.used();
+                           m.normal_texture.used() || m.emissive_texture.used() ||
+                           m.transmission_texture.used();
         if (slots) g.flags |= MATERIAL_TEXTURED;
         if (m.alpha_mode != AlphaMode::Opaque) g.flags |= MATERIAL_ALPHA_TESTED;
         data.materials.push_back(g);

@@ -111,23 +111,23 @@ const tinygltf::Value* extension_object(const tinygltf::Material& source, const 
     return &extension->second;
 }
 
-// KHR_materials_transmission: transmissionFactor in [0, 1] (default 0). Its texture is not
-// read: the factor holds over the whole surface (one warning).
+// KHR_materials_transmission: transmissionFactor in [0, 1] (default 0), times the R channel of
+// transmissionTexture (linear) where there is one.
 // KHR_materials_volume (only with transmission): thicknessFactor ≥ 0 (default 0, thin-walled);
 // > 0 makes the surface bound a volume (thicknessTexture only matters to rasterizers that
 // fake refraction, and is not read); attenuationColor in [0, 1]³ (default white), clamped with
 // one warning; attenuationDistance > 0 (default ∞): 0 or negative is read as ∞, with one warning.
 void read_transmission(const tinygltf::Material& source, const std::string& element,
-                       Diagnostics& diag, Material& material) {
+                       TextureTable& textures, Diagnostics& diag, Material& material) {
     const tinygltf::Value* ext = extension_object(source, "KHR_materials_transmission");
     if (!ext) return;
     material.transmission =
         unit_factor(extension_number(*ext, "transmissionFactor", 0.0),
                     "KHR_materials_transmission.transmissionFactor", element, diag);
-    if (ext->Has("transmissionTexture")) {
-        diag.warn_once("transmission-texture",
-                       element + ": KHR_materials_transmission.transmissionTexture is not "
-                                 "read; transmissionFactor holds over the whole surface");
+    if (ext->Has("transmissionTexture") && material.transmission > 0.0f) {
+        material.transmission_texture =
+            textures.read_value(ext->Get("transmissionTexture"), false,
+                                element + " KHR_materials_transmission.transmissionTexture");
     }
     const tinygltf::Value* volume = extension_object(source, "KHR_materials_volume");
     if (!volume || material.transmission == 0.0f) return;
@@ -231,7 +231,8 @@ const TextureSlot kTextureSlots[] = {
     {"baseColorTexture", &Material::base_color_texture},
     {"metallicRoughnessTexture", &Material::metallic_roughness_texture},
     {"normalTexture", &Material::normal_texture},
-    {"emissiveTexture", &Material::emissive_texture}};
+    {"emissiveTexture", &Material::emissive_texture},
+    {"KHR_materials_transmission.transmissionTexture", &Material::transmission_texture}};
 
 // What of a material mcrt does not render, once per kind.
 void warn_unsupported_parts(const tinygltf::Material& material, Diagnostics& diag) {
@@ -339,7 +340,7 @@ Material MaterialTable::convert(int material_index, const std::string& referrer)
     material.double_sided = source.doubleSided;
     read_microfacet_factors(source, element, diag_, material);
     read_ior(source, element, diag_, material);
-    read_transmission(source, element, diag_, material);
+    read_transmission(source, element, textures_, diag_, material);
     read_alpha(source, element, diag_, material);
     read_texture_slots(source, element, textures_, diag_, material);
     return material;

@@ -118,6 +118,23 @@ TextureRef TextureTable::read(int index, int texcoord, const tinygltf::Extension
     return ref;
 }
 
+TextureRef TextureTable::read_value(const tinygltf::Value& info, bool srgb,
+                                    const std::string& element) {
+    // check_gltf_types has checked the object: a required integer index and texCoord within int.
+    auto integer = [&](const char* name, int fallback) {
+        if (!info.Has(name)) return fallback;
+        const tinygltf::Value& v = info.Get(name);
+        if (!v.IsInt()) diag_.fail(element, std::string(name) + " must be an integer");
+        return v.Get<int>();
+    };
+    tinygltf::ExtensionMap extensions;
+    if (info.Has("extensions") && info.Get("extensions").IsObject()) {
+        const tinygltf::Value& e = info.Get("extensions");
+        for (const std::string& key : e.Keys()) extensions[key] = e.Get(key);
+    }
+    return read(integer("index", -1), integer("texCoord", 0), extensions, srgb, element);
+}
+
 // The glTF image `texture` reads; −1 (with one warning) when it names none.
 int TextureTable::source_image(const tinygltf::Texture& texture,
                                const std::string& texture_element) {

@@ -27,6 +27,10 @@ class TextureTable {
         return read(info.index, info.texCoord, info.extensions, srgb, element);
     }
 
+    // The same for a textureInfo inside an extension (a tinygltf::Value object, its integers
+    // checked by check_gltf_types: index 0..INT_MAX, texCoord too).
+    TextureRef read_value(const tinygltf::Value& info, bool srgb, const std::string& element);
+
     // The glTF image of each Scene::images slot, in slot order: what decode_images decodes.
     const std::vector<int>& image_sources() const { return sources_; }
 

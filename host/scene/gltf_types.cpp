@@ -254,6 +254,13 @@ void check_gltf_property_types(const std::string& name, const unsigned char* dat
                      [&](const json& e, const std::string& eat) {
                          c.properties(e, eat, {{"emissiveStrength", Kind::ExtensionNumber}});
                      });
+            c.object(*ext, "KHR_materials_transmission", ext_at,
+                     [&](const json& e, const std::string& eat) {
+                         c.properties(e, eat, {{"transmissionFactor", Kind::ExtensionNumber},
+                                               {"transmissionTexture", Kind::Object}});
+                         if (const auto info = e.find("transmissionTexture"); info != e.end())
+                             c.texture_info(*info, eat + ".transmissionTexture");
+                     });
             c.object(*ext, "KHR_materials_specular", ext_at,
                      [&](const json& e, const std::string& eat) {
                          c.properties(e, eat,

@@ -106,6 +106,7 @@ void make_lambertian(std::vector<Material>& materials) {
         m.metallic = 0.0f;
         m.specular = 0.0f;
         m.transmission = 0.0f;
+        m.transmission_texture = TextureRef{};  // nothing left for it to scale
     }
 }
 

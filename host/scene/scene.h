@@ -78,13 +78,14 @@ struct Material {
     TextureRef normal_texture;              // linear; tangent-space normal, scaled in x and y
     float normal_scale = 1.0f;              // normalTexture.scale
     TextureRef emissive_texture;            // sRGB; RGB × emission
+    TextureRef transmission_texture;        // linear; R × transmission
 
     // The surface needs the textured kernels (-D MCRT_TEXTURES): a texture, or alpha that a ray
     // query must test (MASK, BLEND).
     bool textured() const {
         return base_color_texture.used() || metallic_roughness_texture.used() ||
                normal_texture.used() || emissive_texture.used() ||
-               alpha_mode != AlphaMode::Opaque;
+               transmission_texture.used() || alpha_mode != AlphaMode::Opaque;
     }
 
     // Exactly the Lambertian albedo/π: no metal, and no specular layer on the dielectric.

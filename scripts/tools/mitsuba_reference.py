@@ -704,7 +704,8 @@ class MaterialConversion:
                 "mcrt, light passing straight through; Mitsuba 3's thindielectric is a slab of "
                 "two interfaces: no equivalent" % self.name)
         if "transmissionTexture" in ext.get("KHR_materials_transmission", {}):
-            warn("%s: transmissionTexture is not read (as mcrt)" % self.name)
+            warn("%s: transmissionTexture is left out of the Mitsuba scene (the factor holds "
+                 "everywhere there)" % self.name)
         glass = {"type": "dielectric", "int_ior": float(ior), "ext_ior": 1.0,
                  "specular_transmittance": base}
         if roughness > 0.0:
