@@ -10,10 +10,15 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <functional>
 #include <csignal>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include "cl/device.h"
@@ -154,6 +159,126 @@ struct PyScene {
     std::vector<std::string> load_warnings;
 };
 
+// Work that runs on a thread of its own while the calling thread, which holds the GIL between
+// waits, checks for signals every 50 ms and calls the progress callback: Ctrl-C then raises
+// KeyboardInterrupt within a second wherever the work is, a kernel build (which no OpenCL call
+// can cut short) included. On a Python exception the work is asked to stop (`interrupted`, the
+// render's stop flag) and left to end in the background: its thread holds what it uses, a
+// render the context's lock, so the context's next call waits for it; a program it built is
+// kept (cl/program.h, cached_program). Interpreter exit waits for such work (wait_background).
+struct Job {
+    volatile std::sig_atomic_t interrupted = 0;
+    std::mutex mutex;
+    std::condition_variable changed;
+    bool done = false;                                // under mutex
+    std::exception_ptr error;                         // what the work threw; set before done
+    std::vector<std::pair<uint32_t, uint32_t>> progress;  // under mutex: not yet told
+
+    // The render's ProgressSink: queues (done, total) for the calling thread.
+    void report(uint32_t done_spp, uint32_t total) {
+        std::lock_guard<std::mutex> lock(mutex);
+        progress.emplace_back(done_spp, total);
+        changed.notify_all();
+    }
+};
+
+// Threads of interrupted work, joined once they end (at the next job, or at exit). Never
+// destroyed: a thread still running when the process ends is not joined by a destructor.
+struct Background {
+    std::mutex mutex;
+    std::vector<std::pair<std::shared_ptr<Job>, std::thread>> threads;
+};
+Background& background() {
+    static Background* b = new Background;
+    return *b;
+}
+
+// Joins the background threads that have ended; with `all`, waits for the others too (checking
+// for signals: a second Ctrl-C gives up the wait and is raised).
+void join_background(bool all) {
+    Background& b = background();
+    for (;;) {
+        std::vector<std::pair<std::shared_ptr<Job>, std::thread>> ended;
+        bool running = false;
+        {
+            std::lock_guard<std::mutex> lock(b.mutex);
+            for (auto it = b.threads.begin(); it != b.threads.end();) {
+                std::lock_guard<std::mutex> job_lock(it->first->mutex);
+                if (it->first->done) {
+                    ended.push_back(std::move(*it));
+                    it = b.threads.erase(it);
+                } else {
+                    running = true;
+                    ++it;
+                }
+            }
+        }
+        for (auto& t : ended) t.second.join();  // it has ended: returns at once
+        if (!all || !running) return;
+        {
+            py::gil_scoped_release release;
+            std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        }
+        if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    }
+}
+
+// Runs `work` on a thread of its own and waits for it as the comment of Job says, calling
+// `progress(done, total)` (if not None) for what the work reported. Rethrows what the work
+// threw, or the Python exception (KeyboardInterrupt, the callback's) at once, the work told to
+// stop and left to end in the background.
+void run_interruptible(const std::function<void(Job&)>& work, const py::object& progress) {
+    join_background(false);
+    auto job = std::make_shared<Job>();
+    std::thread thread([job, work] {
+        std::exception_ptr error;
+        try {
+            work(*job);
+        } catch (...) {
+            error = std::current_exception();
+        }
+        std::lock_guard<std::mutex> lock(job->mutex);
+        job->error = error;
+        job->done = true;
+        job->changed.notify_all();
+    });
+    for (;;) {
+        std::vector<std::pair<uint32_t, uint32_t>> told;
+        bool done = false;
+        {
+            py::gil_scoped_release release;
+            std::unique_lock<std::mutex> lock(job->mutex);
+            job->changed.wait_for(lock, std::chrono::milliseconds(50),
+                                  [&] { return job->done || !job->progress.empty(); });
+            told.swap(job->progress);
+            done = job->done;
+        }
+        try {
+            if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+            if (!progress.is_none())
+                for (const auto& p : told) progress(p.first, p.second);
+        } catch (py::error_already_set&) {
+            job->interrupted = 1;
+            if (done) {
+                thread.join();
+            } else {
+                std::lock_guard<std::mutex> lock(background().mutex);
+                background().threads.emplace_back(job, std::move(thread));
+            }
+            throw;
+        }
+        if (done) break;
+    }
+    thread.join();
+    if (job->error) std::rethrow_exception(job->error);
+}
+
+// `mutex` locked, waited for without the GIL (a render ending in the background may hold it).
+std::unique_lock<std::mutex> lock_without_gil(std::mutex& mutex) {
+    py::gil_scoped_release release;
+    return std::unique_lock<std::mutex>(mutex);
+}
+
 // The options of `args` (the command line's `render` arguments after the scene) as the command
 // line parses and checks them; SettingError with the command line's message otherwise.
 RenderOptions parse_render_options(const std::string& scene, const std::string& materials,
@@ -186,7 +311,6 @@ PyResult render_scene(PyScene& self, const std::vector<std::string>& args,
                       const Estimator* estimator, const py::object& progress) {
     const auto start = std::chrono::steady_clock::now();
     std::shared_ptr<ContextState> context = self.context;
-    const std::string estimator_name = estimator ? estimator->name : "";
     auto data = std::make_shared<ResultData>();
     RenderOptions& o = data->options;
     o = parse_render_options(self.scene->path, self.scene->materials, args);
@@ -199,40 +323,29 @@ PyResult render_scene(PyScene& self, const std::vector<std::string>& args,
         request.settings.estimator_source = estimator->text;
     }
     const std::string user_estimator = o.estimator_file;
+    std::shared_ptr<SessionScene> scene = self.scene;
 
-    // The render runs without the GIL; progress and Ctrl-C are seen from this thread, which
-    // the scheduler's watch loop runs on (render/renderer.h), every 20 ms at most.
-    volatile std::sig_atomic_t interrupted = 0;
-    // What the progress callback raised, or KeyboardInterrupt: raised once the render stopped.
-    std::unique_ptr<py::error_already_set> python_error;
-    ProgressSink sink = [&](uint32_t done, uint32_t total, const std::vector<DeviceReport>&) {
-        if (interrupted) return;
-        py::gil_scoped_acquire gil;
-        try {
-            if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-            if (!progress.is_none()) progress(done, total);
-        } catch (py::error_already_set& e) {
-            interrupted = 1;
-            python_error = std::make_unique<py::error_already_set>(std::move(e));
-        }
-    };
-    RenderControl control;
-    control.time_limit = o.time_limit;
-    control.interrupted = &interrupted;
-    control.keep_replicate_means = true;
-    WarningSink warn = [&](const std::string& w) { data->warnings.push_back(w); };
-
-    std::exception_ptr error;
-    {
-        py::gil_scoped_release release;
-        try {
+    // The render runs on a thread of its own without the GIL (run_interruptible): progress and
+    // Ctrl-C are seen from this thread. The work holds what it uses, as it may outlive this call.
+    run_interruptible(
+        [context, scene, data, request, user_estimator, start](Job& job) {
+            const RenderOptions& o = data->options;
+            RenderControl control;
+            control.time_limit = o.time_limit;
+            control.interrupted = &job.interrupted;
+            control.keep_replicate_means = true;
+            ProgressSink sink = [&job](uint32_t done, uint32_t total,
+                                       const std::vector<DeviceReport>&) {
+                job.report(done, total);
+            };
+            WarningSink warn = [data](const std::string& w) { data->warnings.push_back(w); };
             translating(
                 [&] {
                     std::lock_guard<std::mutex> context_lock(context->mutex);
                     if (!context->session)
                         throw PyDeviceError("the context of this scene is closed");
-                    std::lock_guard<std::mutex> scene_lock(self.scene->use);
-                    const RenderPlan plan = plan_session_render(*self.scene, request, warn);
+                    std::lock_guard<std::mutex> scene_lock(scene->use);
+                    const RenderPlan plan = plan_session_render(*scene, request, warn);
                     check_host_memory("a " + std::to_string(o.width) + "x" +
                                           std::to_string(o.height) + " render",
                                       render_host_bytes(o.width, o.height,
@@ -240,31 +353,24 @@ PyResult render_scene(PyScene& self, const std::vector<std::string>& args,
                     const double seconds_to_render =
                         std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
                             .count();
-                    data->result =
-                        context->session->render(self.scene, plan, sink, control, warn);
-                    if (!data->result.stopped_by.empty() && !interrupted)
+                    data->result = context->session->render(scene, plan, sink, control, warn);
+                    if (job.interrupted) return 0;  // the caller raised already
+                    if (!data->result.stopped_by.empty())
                         warn("stopped by " + data->result.stopped_by + " after " +
                              std::to_string(data->result.spp) + " of " + std::to_string(o.spp) +
                              " samples per pixel");
-                    if (!interrupted) check_render_result(data->result, warn);
+                    check_render_result(data->result, warn);
                     const double total =
                         std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
                             .count();
-                    if (!interrupted)
-                        data->stats_json =
-                            render_stats_json({o, plan, self.scene->prepared, data->result,
-                                               total, seconds_to_render})
-                                .dump();
+                    data->stats_json = render_stats_json({o, plan, scene->prepared, data->result,
+                                                          total, seconds_to_render})
+                                           .dump();
                     return 0;
                 },
                 InputKind::Setting, user_estimator);
-        } catch (...) {
-            error = std::current_exception();
-        }
-    }
-    // Ctrl-C or the callback's exception wins over what the stopped render said.
-    if (python_error) throw py::error_already_set(std::move(*python_error));
-    if (error) std::rethrow_exception(error);
+        },
+        progress);
     return PyResult{data};
 }
 
@@ -338,6 +444,20 @@ PYBIND11_MODULE(_mcrt, m) {
         for (const DeviceInfo& d : devices) list.append(device_dict(d));
         return list;
     });
+    m.def("_wait_background", [] { join_background(true); },
+          "Waits for work that an interrupted render or load left running (called at exit).");
+    m.def(
+        "_background_running",
+        [] {
+            size_t running = 0;
+            std::lock_guard<std::mutex> lock(background().mutex);
+            for (const auto& t : background().threads) {
+                std::lock_guard<std::mutex> job_lock(t.first->mutex);
+                running += t.first->done ? 0 : 1;
+            }
+            return running;
+        },
+        "How many interrupted renders and loads are still running (tests).");
     m.def("variants_json", [] { return variants_json(); });
 
     py::class_<Estimator>(m, "Estimator")
@@ -436,12 +556,12 @@ PYBIND11_MODULE(_mcrt, m) {
         .def_property_readonly("warnings", [](const ContextState& c) { return c.warnings; })
         .def_property_readonly("closed",
                                [](ContextState& c) {
-                                   std::lock_guard<std::mutex> lock(c.mutex);
+                                   std::unique_lock<std::mutex> lock = lock_without_gil(c.mutex);
                                    return !c.session;
                                })
         .def_property_readonly("devices",
                                [](ContextState& c) {
-                                   std::lock_guard<std::mutex> lock(c.mutex);
+                                   std::unique_lock<std::mutex> lock = lock_without_gil(c.mutex);
                                    py::list list;
                                    if (c.session)
                                        for (const DeviceContext* d : c.session->devices())
@@ -458,24 +578,36 @@ PYBIND11_MODULE(_mcrt, m) {
             "load",
             [](std::shared_ptr<ContextState> c, const std::string& path,
                const std::string& materials) {
-                PyScene scene;
-                scene.context = c;
-                {
-                    std::lock_guard<std::mutex> lock(c->mutex);
-                    if (!c->session) throw PyDeviceError("the context is closed");
-                }
-                WarningSink warn = [&](const std::string& w) {
-                    scene.load_warnings.push_back(w);
-                };
                 // The materials name is checked as the command line checks --materials.
                 parse_render_options("scene.gltf", materials, {});
-                py::gil_scoped_release release;
-                scene.scene = translating(
-                    [&] {
-                        return load_session_scene(path, materials, LightSelection::Power,
-                                                  SceneSource{}, warn);
+                // Read on a thread of its own, as a render runs (run_interruptible): Ctrl-C
+                // raises at once and the load, abandoned, ends in the background.
+                struct Loaded {
+                    std::shared_ptr<SessionScene> scene;
+                    std::vector<std::string> warnings;
+                };
+                auto loaded = std::make_shared<Loaded>();
+                run_interruptible(
+                    [c, loaded, path, materials](Job&) {
+                        {
+                            std::lock_guard<std::mutex> lock(c->mutex);
+                            if (!c->session) throw PyDeviceError("the context is closed");
+                        }
+                        WarningSink warn = [loaded](const std::string& w) {
+                            loaded->warnings.push_back(w);
+                        };
+                        loaded->scene = translating(
+                            [&] {
+                                return load_session_scene(path, materials, LightSelection::Power,
+                                                          SceneSource{}, warn);
+                            },
+                            InputKind::Scene);
                     },
-                    InputKind::Scene);
+                    py::none());
+                PyScene scene;
+                scene.context = c;
+                scene.scene = loaded->scene;
+                scene.load_warnings = loaded->warnings;
                 return scene;
             },
             py::arg("path"), py::arg("materials") = "gltf")

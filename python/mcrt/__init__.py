@@ -12,12 +12,17 @@ the command line's own (the arguments are parsed by its parser), and the same re
 the same bytes.
 """
 
+import atexit as _atexit
 import json as _json
 import math as _math
 import numbers as _numbers
 
 from . import _mcrt
 from ._mcrt import DeviceError, EstimatorError, Estimator, Result, SceneError, SettingError
+
+# A render or load interrupted by Ctrl-C ends in the background (a kernel build cannot be cut
+# short); the interpreter waits for it before it tears down (docs/PYTHON.md, "Threads and Ctrl-C").
+_atexit.register(_mcrt._wait_background)
 
 __all__ = ["Context", "Scene", "Result", "Estimator", "devices", "variants", "render",
            "SettingError", "SceneError", "EstimatorError", "DeviceError"]
