@@ -10,14 +10,12 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
-#include <condition_variable>
 #include <exception>
 #include <functional>
 #include <csignal>
 #include <memory>
 #include <mutex>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -29,6 +27,7 @@
 #include "cli/validators.h"
 #include "common/error.h"
 #include "image/image.h"
+#include "interruptible.h"
 #include "render/memory_estimate.h"
 #include "render/estimator_file.h"
 #include "render/session.h"
@@ -158,120 +157,6 @@ struct PyScene {
     std::shared_ptr<SessionScene> scene;
     std::vector<std::string> load_warnings;
 };
-
-// Work that runs on a thread of its own while the calling thread, which holds the GIL between
-// waits, checks for signals every 50 ms and calls the progress callback: Ctrl-C then raises
-// KeyboardInterrupt within a second wherever the work is, a kernel build (which no OpenCL call
-// can cut short) included. On a Python exception the work is asked to stop (`interrupted`, the
-// render's stop flag) and left to end in the background: its thread holds what it uses, a
-// render the context's lock, so the context's next call waits for it; a program it built is
-// kept (cl/program.h, cached_program). Interpreter exit waits for such work (wait_background).
-struct Job {
-    volatile std::sig_atomic_t interrupted = 0;
-    std::mutex mutex;
-    std::condition_variable changed;
-    bool done = false;                                // under mutex
-    std::exception_ptr error;                         // what the work threw; set before done
-    std::vector<std::pair<uint32_t, uint32_t>> progress;  // under mutex: not yet told
-
-    // The render's ProgressSink: queues (done, total) for the calling thread.
-    void report(uint32_t done_spp, uint32_t total) {
-        std::lock_guard<std::mutex> lock(mutex);
-        progress.emplace_back(done_spp, total);
-        changed.notify_all();
-    }
-};
-
-// Threads of interrupted work, joined once they end (at the next job, or at exit). Never
-// destroyed: a thread still running when the process ends is not joined by a destructor.
-struct Background {
-    std::mutex mutex;
-    std::vector<std::pair<std::shared_ptr<Job>, std::thread>> threads;
-};
-Background& background() {
-    static Background* b = new Background;
-    return *b;
-}
-
-// Joins the background threads that have ended; with `all`, waits for the others too (checking
-// for signals: a second Ctrl-C gives up the wait and is raised).
-void join_background(bool all) {
-    Background& b = background();
-    for (;;) {
-        std::vector<std::pair<std::shared_ptr<Job>, std::thread>> ended;
-        bool running = false;
-        {
-            std::lock_guard<std::mutex> lock(b.mutex);
-            for (auto it = b.threads.begin(); it != b.threads.end();) {
-                std::lock_guard<std::mutex> job_lock(it->first->mutex);
-                if (it->first->done) {
-                    ended.push_back(std::move(*it));
-                    it = b.threads.erase(it);
-                } else {
-                    running = true;
-                    ++it;
-                }
-            }
-        }
-        for (auto& t : ended) t.second.join();  // it has ended: returns at once
-        if (!all || !running) return;
-        {
-            py::gil_scoped_release release;
-            std::this_thread::sleep_for(std::chrono::milliseconds(50));
-        }
-        if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-    }
-}
-
-// Runs `work` on a thread of its own and waits for it as the comment of Job says, calling
-// `progress(done, total)` (if not None) for what the work reported. Rethrows what the work
-// threw, or the Python exception (KeyboardInterrupt, the callback's) at once, the work told to
-// stop and left to end in the background.
-void run_interruptible(const std::function<void(Job&)>& work, const py::object& progress) {
-    join_background(false);
-    auto job = std::make_shared<Job>();
-    std::thread thread([job, work] {
-        std::exception_ptr error;
-        try {
-            work(*job);
-        } catch (...) {
-            error = std::current_exception();
-        }
-        std::lock_guard<std::mutex> lock(job->mutex);
-        job->error = error;
-        job->done = true;
-        job->changed.notify_all();
-    });
-    for (;;) {
-        std::vector<std::pair<uint32_t, uint32_t>> told;
-        bool done = false;
-        {
-            py::gil_scoped_release release;
-            std::unique_lock<std::mutex> lock(job->mutex);
-            job->changed.wait_for(lock, std::chrono::milliseconds(50),
-                                  [&] { return job->done || !job->progress.empty(); });
-            told.swap(job->progress);
-            done = job->done;
-        }
-        try {
-            if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-            if (!progress.is_none())
-                for (const auto& p : told) progress(p.first, p.second);
-        } catch (py::error_already_set&) {
-            job->interrupted = 1;
-            if (done) {
-                thread.join();
-            } else {
-                std::lock_guard<std::mutex> lock(background().mutex);
-                background().threads.emplace_back(job, std::move(thread));
-            }
-            throw;
-        }
-        if (done) break;
-    }
-    thread.join();
-    if (job->error) std::rethrow_exception(job->error);
-}
 
 // `mutex` locked, waited for without the GIL (a render ending in the background may hold it).
 std::unique_lock<std::mutex> lock_without_gil(std::mutex& mutex) {
@@ -446,18 +331,8 @@ PYBIND11_MODULE(_mcrt, m) {
     });
     m.def("_wait_background", [] { join_background(true); },
           "Waits for work that an interrupted render or load left running (called at exit).");
-    m.def(
-        "_background_running",
-        [] {
-            size_t running = 0;
-            std::lock_guard<std::mutex> lock(background().mutex);
-            for (const auto& t : background().threads) {
-                std::lock_guard<std::mutex> job_lock(t.first->mutex);
-                running += t.first->done ? 0 : 1;
-            }
-            return running;
-        },
-        "How many interrupted renders and loads are still running (tests).");
+    m.def("_background_running", &background_running,
+          "How many interrupted renders and loads are still running (tests).");
     m.def("variants_json", [] { return variants_json(); });
 
     py::class_<Estimator>(m, "Estimator")

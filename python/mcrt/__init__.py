@@ -115,7 +115,9 @@ class Scene:
     def render(self, progress=None, **options):
         """Renders the scene; keywords are `mcrt render`'s options with `_` for `-`
         (estimator may also be an Estimator from Context.estimator). `progress(done, total)`
-        is called from this thread with the samples per pixel done. Returns a Result."""
+        is called from this thread with the samples per pixel done. Ctrl-C raises
+        KeyboardInterrupt at once, even during a kernel build (docs/PYTHON.md). Returns a
+        Result."""
         estimator = options.get("estimator")
         user = None
         if isinstance(estimator, Estimator):
@@ -170,7 +172,7 @@ class Context:
 
     def load(self, path, materials="gltf"):
         """Reads a glTF scene once (SceneError when it cannot be read); materials as
-        `mcrt render --materials`."""
+        `mcrt render --materials`. Ctrl-C raises KeyboardInterrupt at once."""
         if not isinstance(path, (str, bytes)) and not hasattr(path, "__fspath__"):
             raise TypeError("path: expected a str or path, got %s" % type(path).__name__)
         if not isinstance(materials, str):
