@@ -24,7 +24,7 @@ Background& background() {
 
 void join_background(bool all) {
     Background& b = background();
-    for (;;) {
+    for (int waits = 0;; ++waits) {
         std::vector<std::pair<std::shared_ptr<Job>, std::thread>> ended;
         bool running = false;
         {
@@ -42,6 +42,10 @@ void join_background(bool all) {
         }
         for (auto& t : ended) t.second.join();  // it has ended: returns at once
         if (!all || !running) return;
+        if (waits == 20)  // a drain ends sooner: this is a kernel build or a load
+            PySys_WriteStderr(
+                "mcrt: waiting for an interrupted kernel build or load to end (Ctrl-C again: "
+                "quit without waiting)\n");
         {
             py::gil_scoped_release release;
             std::this_thread::sleep_for(std::chrono::milliseconds(50));
