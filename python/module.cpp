@@ -9,6 +9,7 @@
 #include <pybind11/stl.h>
 
 #include <CLI/CLI.hpp>
+#include <atomic>
 #include <chrono>
 #include <exception>
 #include <functional>
@@ -139,6 +140,8 @@ struct ContextState {
     std::unique_ptr<RenderSession> session;
     std::vector<std::string> warnings;  // of the device selection
     std::mutex mutex;                   // guards `session` against close() during a render
+    // Set by close(): read without the mutex, which a render ending in the background may hold.
+    std::atomic<bool> closed{false};
 };
 
 struct ResultData {
@@ -431,8 +434,7 @@ PYBIND11_MODULE(_mcrt, m) {
         .def_property_readonly("warnings", [](const ContextState& c) { return c.warnings; })
         .def_property_readonly("closed",
                                [](ContextState& c) {
-                                   std::unique_lock<std::mutex> lock = lock_without_gil(c.mutex);
-                                   return !c.session;
+                                   return c.closed.load();
                                })
         .def_property_readonly("devices",
                                [](ContextState& c) {
@@ -446,6 +448,7 @@ PYBIND11_MODULE(_mcrt, m) {
         .def("close",
              [](ContextState& c) {
                  py::gil_scoped_release release;  // waits for a render in another thread
+                 c.closed = true;
                  std::lock_guard<std::mutex> lock(c.mutex);
                  c.session.reset();
              })
@@ -464,10 +467,7 @@ PYBIND11_MODULE(_mcrt, m) {
                 auto loaded = std::make_shared<Loaded>();
                 run_interruptible(
                     [c, loaded, path, materials](Job&) {
-                        {
-                            std::lock_guard<std::mutex> lock(c->mutex);
-                            if (!c->session) throw PyDeviceError("the context is closed");
-                        }
+                        if (c->closed) throw PyDeviceError("the context is closed");
                         WarningSink warn = [loaded](const std::string& w) {
                             loaded->warnings.push_back(w);
                         };
