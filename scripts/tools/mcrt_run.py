@@ -216,8 +216,8 @@ def add_cli_option(parser):
 
 def use_module(binary=None, cli=False):
     """From now on, render() renders through the Python module `mcrt` when it can be imported
-    (from PYTHONPATH, else from python/ beside the executable, as scripts/setup builds it) and
-    was built with `binary` (default_mcrt()); not with `cli`. Returns where it was imported
+    (from PYTHONPATH, else from python/ beside the executable, as scripts/setup builds it), was
+    built with `binary` (default_mcrt()) and not before its library; not with `cli`. Returns where it was imported
     from, or None when renders stay commands."""
     if cli:
         return None
@@ -240,6 +240,15 @@ def use_module(binary=None, cli=False):
     if os.path.realpath(built_with) != binary:
         print("%s: the module %s is not %s's: rendering with commands"
               % (os.path.basename(sys.argv[0]), module.__file__, binary), file=sys.stderr)
+        return None
+    # A module linked before the library it shares with the executable (only `mcrt` rebuilt
+    # after a change) would render with the old kernels.
+    core = Path(binary).parent / "libmcrt_core.a"
+    extension = Path(module._mcrt.__file__)
+    if core.is_file() and extension.stat().st_mtime < core.stat().st_mtime:
+        print("%s: the module %s is older than %s (cmake --build %s --target mcrt_python): "
+              "rendering with commands" % (os.path.basename(sys.argv[0]), extension, core,
+                                           Path(binary).parent), file=sys.stderr)
         return None
     _MODULE.update(module=module, binary=binary)
     print("%s: rendering through the Python module in %s (--cli: a command per render)"
