@@ -3,6 +3,7 @@
 // checks and the one-shot mcrt.render() are python/mcrt/__init__.py's; a render's options arrive
 // here as the command line's arguments and are parsed and checked by the command line's own
 // parser (cli/render_command.h), so that defaults, validation and messages are the command's.
+// Renders and loads run on threads of their own (interruptible.h), so that Ctrl-C reaches them.
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -13,7 +14,6 @@
 #include <chrono>
 #include <exception>
 #include <functional>
-#include <csignal>
 #include <memory>
 #include <mutex>
 #include <string>
