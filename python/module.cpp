@@ -3,17 +3,21 @@
 // checks and the one-shot mcrt.render() are python/mcrt/__init__.py's; a render's options arrive
 // here as the command line's arguments and are parsed and checked by the command line's own
 // parser (cli/render_command.h), so that defaults, validation and messages are the command's.
+// Renders and loads run on threads of their own (interruptible.h), so that Ctrl-C reaches them.
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <CLI/CLI.hpp>
+#include <atomic>
 #include <chrono>
-#include <csignal>
+#include <exception>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cl/device.h"
@@ -24,6 +28,7 @@
 #include "cli/validators.h"
 #include "common/error.h"
 #include "image/image.h"
+#include "interruptible.h"
 #include "render/memory_estimate.h"
 #include "render/estimator_file.h"
 #include "render/session.h"
@@ -135,6 +140,8 @@ struct ContextState {
     std::unique_ptr<RenderSession> session;
     std::vector<std::string> warnings;  // of the device selection
     std::mutex mutex;                   // guards `session` against close() during a render
+    // Set by close(): read without the mutex, which a render ending in the background may hold.
+    std::atomic<bool> closed{false};
 };
 
 struct ResultData {
@@ -153,6 +160,12 @@ struct PyScene {
     std::shared_ptr<SessionScene> scene;
     std::vector<std::string> load_warnings;
 };
+
+// `mutex` locked, waited for without the GIL (a render ending in the background may hold it).
+std::unique_lock<std::mutex> lock_without_gil(std::mutex& mutex) {
+    py::gil_scoped_release release;
+    return std::unique_lock<std::mutex>(mutex);
+}
 
 // The options of `args` (the command line's `render` arguments after the scene) as the command
 // line parses and checks them; SettingError with the command line's message otherwise.
@@ -186,7 +199,6 @@ PyResult render_scene(PyScene& self, const std::vector<std::string>& args,
                       const Estimator* estimator, const py::object& progress) {
     const auto start = std::chrono::steady_clock::now();
     std::shared_ptr<ContextState> context = self.context;
-    const std::string estimator_name = estimator ? estimator->name : "";
     auto data = std::make_shared<ResultData>();
     RenderOptions& o = data->options;
     o = parse_render_options(self.scene->path, self.scene->materials, args);
@@ -199,40 +211,29 @@ PyResult render_scene(PyScene& self, const std::vector<std::string>& args,
         request.settings.estimator_source = estimator->text;
     }
     const std::string user_estimator = o.estimator_file;
+    std::shared_ptr<SessionScene> scene = self.scene;
 
-    // The render runs without the GIL; progress and Ctrl-C are seen from this thread, which
-    // the scheduler's watch loop runs on (render/renderer.h), every 20 ms at most.
-    volatile std::sig_atomic_t interrupted = 0;
-    // What the progress callback raised, or KeyboardInterrupt: raised once the render stopped.
-    std::unique_ptr<py::error_already_set> python_error;
-    ProgressSink sink = [&](uint32_t done, uint32_t total, const std::vector<DeviceReport>&) {
-        if (interrupted) return;
-        py::gil_scoped_acquire gil;
-        try {
-            if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-            if (!progress.is_none()) progress(done, total);
-        } catch (py::error_already_set& e) {
-            interrupted = 1;
-            python_error = std::make_unique<py::error_already_set>(std::move(e));
-        }
-    };
-    RenderControl control;
-    control.time_limit = o.time_limit;
-    control.interrupted = &interrupted;
-    control.keep_replicate_means = true;
-    WarningSink warn = [&](const std::string& w) { data->warnings.push_back(w); };
-
-    std::exception_ptr error;
-    {
-        py::gil_scoped_release release;
-        try {
+    // The render runs on a thread of its own without the GIL (run_interruptible): progress and
+    // Ctrl-C are seen from this thread. The work holds what it uses, as it may outlive this call.
+    run_interruptible(
+        [context, scene, data, request, user_estimator, start](Job& job) {
+            const RenderOptions& o = data->options;
+            RenderControl control;
+            control.time_limit = o.time_limit;
+            control.interrupted = &job.interrupted;
+            control.keep_replicate_means = true;
+            ProgressSink sink = [&job](uint32_t done, uint32_t total,
+                                       const std::vector<DeviceReport>&) {
+                job.report(done, total);
+            };
+            WarningSink warn = [data](const std::string& w) { data->warnings.push_back(w); };
             translating(
                 [&] {
                     std::lock_guard<std::mutex> context_lock(context->mutex);
                     if (!context->session)
                         throw PyDeviceError("the context of this scene is closed");
-                    std::lock_guard<std::mutex> scene_lock(self.scene->use);
-                    const RenderPlan plan = plan_session_render(*self.scene, request, warn);
+                    std::lock_guard<std::mutex> scene_lock(scene->use);
+                    const RenderPlan plan = plan_session_render(*scene, request, warn);
                     check_host_memory("a " + std::to_string(o.width) + "x" +
                                           std::to_string(o.height) + " render",
                                       render_host_bytes(o.width, o.height,
@@ -240,31 +241,24 @@ PyResult render_scene(PyScene& self, const std::vector<std::string>& args,
                     const double seconds_to_render =
                         std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
                             .count();
-                    data->result =
-                        context->session->render(self.scene, plan, sink, control, warn);
-                    if (!data->result.stopped_by.empty() && !interrupted)
+                    data->result = context->session->render(scene, plan, sink, control, warn);
+                    if (job.interrupted) return 0;  // the caller raised already
+                    if (!data->result.stopped_by.empty())
                         warn("stopped by " + data->result.stopped_by + " after " +
                              std::to_string(data->result.spp) + " of " + std::to_string(o.spp) +
                              " samples per pixel");
-                    if (!interrupted) check_render_result(data->result, warn);
+                    check_render_result(data->result, warn);
                     const double total =
                         std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
                             .count();
-                    if (!interrupted)
-                        data->stats_json =
-                            render_stats_json({o, plan, self.scene->prepared, data->result,
-                                               total, seconds_to_render})
-                                .dump();
+                    data->stats_json = render_stats_json({o, plan, scene->prepared, data->result,
+                                                          total, seconds_to_render})
+                                           .dump();
                     return 0;
                 },
                 InputKind::Setting, user_estimator);
-        } catch (...) {
-            error = std::current_exception();
-        }
-    }
-    // Ctrl-C or the callback's exception wins over what the stopped render said.
-    if (python_error) throw py::error_already_set(std::move(*python_error));
-    if (error) std::rethrow_exception(error);
+        },
+        progress);
     return PyResult{data};
 }
 
@@ -338,6 +332,10 @@ PYBIND11_MODULE(_mcrt, m) {
         for (const DeviceInfo& d : devices) list.append(device_dict(d));
         return list;
     });
+    m.def("_wait_background", [] { join_background(true); },
+          "Waits for work that an interrupted render or load left running (called at exit).");
+    m.def("_background_running", &background_running,
+          "How many interrupted renders and loads are still running (tests).");
     m.def("variants_json", [] { return variants_json(); });
 
     py::class_<Estimator>(m, "Estimator")
@@ -436,12 +434,11 @@ PYBIND11_MODULE(_mcrt, m) {
         .def_property_readonly("warnings", [](const ContextState& c) { return c.warnings; })
         .def_property_readonly("closed",
                                [](ContextState& c) {
-                                   std::lock_guard<std::mutex> lock(c.mutex);
-                                   return !c.session;
+                                   return c.closed.load();
                                })
         .def_property_readonly("devices",
                                [](ContextState& c) {
-                                   std::lock_guard<std::mutex> lock(c.mutex);
+                                   std::unique_lock<std::mutex> lock = lock_without_gil(c.mutex);
                                    py::list list;
                                    if (c.session)
                                        for (const DeviceContext* d : c.session->devices())
@@ -451,6 +448,7 @@ PYBIND11_MODULE(_mcrt, m) {
         .def("close",
              [](ContextState& c) {
                  py::gil_scoped_release release;  // waits for a render in another thread
+                 c.closed = true;
                  std::lock_guard<std::mutex> lock(c.mutex);
                  c.session.reset();
              })
@@ -458,24 +456,33 @@ PYBIND11_MODULE(_mcrt, m) {
             "load",
             [](std::shared_ptr<ContextState> c, const std::string& path,
                const std::string& materials) {
-                PyScene scene;
-                scene.context = c;
-                {
-                    std::lock_guard<std::mutex> lock(c->mutex);
-                    if (!c->session) throw PyDeviceError("the context is closed");
-                }
-                WarningSink warn = [&](const std::string& w) {
-                    scene.load_warnings.push_back(w);
-                };
                 // The materials name is checked as the command line checks --materials.
                 parse_render_options("scene.gltf", materials, {});
-                py::gil_scoped_release release;
-                scene.scene = translating(
-                    [&] {
-                        return load_session_scene(path, materials, LightSelection::Power,
-                                                  SceneSource{}, warn);
+                // Read on a thread of its own, as a render runs (run_interruptible): Ctrl-C
+                // raises at once and the load, abandoned, ends in the background.
+                struct Loaded {
+                    std::shared_ptr<SessionScene> scene;
+                    std::vector<std::string> warnings;
+                };
+                auto loaded = std::make_shared<Loaded>();
+                run_interruptible(
+                    [c, loaded, path, materials](Job&) {
+                        if (c->closed) throw PyDeviceError("the context is closed");
+                        WarningSink warn = [loaded](const std::string& w) {
+                            loaded->warnings.push_back(w);
+                        };
+                        loaded->scene = translating(
+                            [&] {
+                                return load_session_scene(path, materials, LightSelection::Power,
+                                                          SceneSource{}, warn);
+                            },
+                            InputKind::Scene);
                     },
-                    InputKind::Scene);
+                    py::none());
+                PyScene scene;
+                scene.context = c;
+                scene.scene = loaded->scene;
+                scene.load_warnings = loaded->warnings;
                 return scene;
             },
             py::arg("path"), py::arg("materials") = "gltf")

@@ -12,12 +12,17 @@ the command line's own (the arguments are parsed by its parser), and the same re
 the same bytes.
 """
 
+import atexit as _atexit
 import json as _json
 import math as _math
 import numbers as _numbers
 
 from . import _mcrt
 from ._mcrt import DeviceError, EstimatorError, Estimator, Result, SceneError, SettingError
+
+# A render or load interrupted by Ctrl-C ends in the background (a kernel build cannot be cut
+# short); the interpreter waits for it before it tears down (docs/PYTHON.md, "Threads and Ctrl-C").
+_atexit.register(_mcrt._wait_background)
 
 __all__ = ["Context", "Scene", "Result", "Estimator", "devices", "variants", "render",
            "SettingError", "SceneError", "EstimatorError", "DeviceError"]
@@ -110,7 +115,9 @@ class Scene:
     def render(self, progress=None, **options):
         """Renders the scene; keywords are `mcrt render`'s options with `_` for `-`
         (estimator may also be an Estimator from Context.estimator). `progress(done, total)`
-        is called from this thread with the samples per pixel done. Returns a Result."""
+        is called from this thread with the samples per pixel done. Ctrl-C raises
+        KeyboardInterrupt at once, even during a kernel build (docs/PYTHON.md). Returns a
+        Result."""
         estimator = options.get("estimator")
         user = None
         if isinstance(estimator, Estimator):
@@ -165,7 +172,7 @@ class Context:
 
     def load(self, path, materials="gltf"):
         """Reads a glTF scene once (SceneError when it cannot be read); materials as
-        `mcrt render --materials`."""
+        `mcrt render --materials`. Ctrl-C raises KeyboardInterrupt at once."""
         if not isinstance(path, (str, bytes)) and not hasattr(path, "__fspath__"):
             raise TypeError("path: expected a str or path, got %s" % type(path).__name__)
         if not isinstance(materials, str):

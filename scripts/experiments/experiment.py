@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """Speed against accuracy: error against time for every estimator configuration of a scene.
 
-Renders SCENE with `mcrt render` for every estimator × light selection × sampler × level (an spp
+Renders SCENE (through the Python module when it is built beside --mcrt, the scene loaded
+once; with --cli, or without the module, with one `mcrt render` each: the same images) for
+every estimator × light selection × sampler × level (an spp
 count, or a time budget given to mcrt's --time-limit) × repeat, compares each image with a
 reference and writes DIR/results.csv and charts:
 
@@ -10,7 +12,8 @@ reference and writes DIR/results.csv and charts:
              MSE of the denoising literature; ε keeps black pixels from dominating);
   efficiency 1 / (MSE × seconds), seconds = `seconds_render` of the stats JSON: the time of the
              render kernels from OpenCL profiling events, without start-up and kernel build
-             (PBRT 3rd ed. 13.1.2's efficiency); `wall_seconds` is the whole process.
+             (PBRT 3rd ed. 13.1.2's efficiency); `wall_seconds` is the whole process (through the
+             module: the call, with the EXR's writing).
 
 The MSE against a noisy reference is the render's MSE plus the reference's own (they are
 independent), so errors cannot be measured below the reference's noise: its RMSE is written in
@@ -40,6 +43,7 @@ Usage: scripts/experiments/experiment.py SCENE --estimators a,b,... [--light-sel
            [--samplers independent,...] (--spp 1,4,16,... | --seconds 0.5,1,2,...)
            [--materials gltf|lambert]
            [--width W --height H] [--reference auto|FILE.exr] [--repeats K] --out DIR [--quick]
+           [--mcrt build/mcrt] [--cli]
 """
 
 import argparse
@@ -393,6 +397,7 @@ def parse_args(argv=None):
     p.add_argument("--quick", action="store_true",
                    help="32×32 image, spp 1,4,16 unless given, 1 repeat, 512 spp reference")
     mcrt_run.add_mcrt_option(p)
+    mcrt_run.add_cli_option(p)
     p.add_argument("--keep-images", action="store_true", help="keep every render's EXR and JSON")
     args = p.parse_args(argv)
     quick = args.quick
@@ -428,6 +433,7 @@ def main(argv=None):
     selects = mcrt_run.comma_list(args.light_select)
     samplers = mcrt_run.comma_list(args.samplers)
     check_variants(args, estimators, selects, samplers)
+    mcrt_run.use_module(args.mcrt, args.cli)
     plt = mcrt_run.pyplot()
 
     scene = Path(args.scene)

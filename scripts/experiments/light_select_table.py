@@ -22,7 +22,10 @@ Prints a Markdown table per estimator, one row per scene, and writes DIR/results
 
 Usage: scripts/experiments/light_select_table.py [SCENE ...] [--selections uniform,power,alias,tree]
            [--estimators light-area] [--spp 64] [--size 128] [--seeds 3] [--crop X,Y,W]
-           --out DIR
+           --out DIR [--mcrt build/mcrt] [--cli]
+
+Renders through the Python module built beside --mcrt when there is one (each scene loaded
+once), else, or with --cli, with one `mcrt render` each: the same images.
 """
 
 import argparse
@@ -136,8 +139,10 @@ def main():
     p.add_argument("--no-strips", action="store_true", help="skip the equal-time crops")
     p.add_argument("--out", type=mcrt_run.output_directory, required=True)
     mcrt_run.add_mcrt_option(p)
+    mcrt_run.add_cli_option(p)
     a = p.parse_args()
     mcrt_run.check_choices("light selection", a.selections, "light_select", mcrt=a.mcrt)
+    mcrt_run.use_module(a.mcrt, a.cli)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     results = {}

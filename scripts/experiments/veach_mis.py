@@ -15,7 +15,10 @@ reference (mis, power heuristic, Sobol, --reference-spp), and writes:
 The plates' pixels are found by projecting each plate's box through the scene's camera.
 
 Usage: scripts/experiments/veach_mis.py [--scene scenes/veach-mis/veach-mis.gltf] [--size 384x216]
-           [--seconds 0.5,1,2,4] [--reference-spp 4096] --out DIR
+           [--seconds 0.5,1,2,4] [--reference-spp 4096] --out DIR [--mcrt build/mcrt] [--cli]
+
+Renders through the Python module built beside --mcrt when there is one (the scene loaded once,
+each estimator's kernels built once), else, or with --cli, with one `mcrt render` each.
 """
 
 import argparse
@@ -95,7 +98,9 @@ def main():
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--out", type=mcrt_run.output_directory, required=True)
     mcrt_run.add_mcrt_option(p)
+    mcrt_run.add_cli_option(p)
     args = p.parse_args()
+    mcrt_run.use_module(args.mcrt, args.cli)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     width, height = args.size

@@ -13,6 +13,11 @@ names and users' FILE.cl alike; read_image_file (an EXR as (3, H, W) arrays); co
 image_size, add_mcrt_option, check_choices for command lines; pyplot and save_png for charts.
 Scripts that only read the stats JSON (render(..., read_image=False)) need no numpy.
 
+A sweep renders through the Python module instead of a command per point once it calls
+use_module(args.mcrt, args.cli) (add_cli_option adds --cli): each scene is then loaded once and
+each variant built once per process, and render() writes the same STEM.exr (the same bytes)
+and STEM.json (the same keys; the timings are the call's) as the command would.
+
 Errors are raised as ScriptError (one line, naming the command); `script_main` turns them into
 one `NAME: error: ...` line and exit status 2, so no script prints a traceback for them.
 """
@@ -175,18 +180,127 @@ class Render:
 
 def render(scene, stem, options, mcrt=None, env=None, read_image=True):
     """`mcrt render SCENE --out STEM.exr --stats STEM.json --quiet OPTIONS`; returns a Render
-    (rgb and variance None when not `read_image`: then numpy is not needed)."""
+    (rgb and variance None when not `read_image`: then numpy is not needed). After use_module,
+    rendered by the Python module when `mcrt` is the executable it was built with and no `env`
+    is asked for; `wall_seconds` is then the call's (the render and the files' writing)."""
     stem = str(stem)
     command = [mcrt_binary(mcrt), "render", str(scene), "--out", stem + ".exr",
                "--stats", stem + ".json", "--quiet"] + [str(o) for o in options]
     start = time.monotonic()
-    run(command, env)
+    if env is None and _module_for(command[0]) is not None:
+        _render_in_module(scene, stem, [str(o) for o in options], command)
+    else:
+        run(command, env)
     wall = time.monotonic() - start
     stats = json.loads(Path(stem + ".json").read_text())
     if not read_image:
         return Render(None, None, stats, wall, command)
     rgb, variance = read_image_file(stem + ".exr")
     return Render(rgb, variance, stats, wall, command)
+
+
+# ----- the Python module ---------------------------------------------------------------------
+
+_MODULE = {"module": None, "binary": None, "contexts": {}, "scenes": {}}
+# Options of `mcrt render` that the module takes elsewhere than in a render: the scene's
+# materials (Context.load), the devices (Context), the PNG (Result.save).
+_LOAD_OPTIONS = ("--materials", "--device", "--png", "--exposure")
+
+
+def add_cli_option(parser):
+    """--cli: a command per render even where the Python module could render the sweep."""
+    parser.add_argument("--cli", action="store_true",
+                        help="render each point with an `mcrt render` command instead of the "
+                             "Python module built beside the executable (the same images)")
+
+
+def use_module(binary=None, cli=False):
+    """From now on, render() renders through the Python module `mcrt` when it can be imported
+    (from PYTHONPATH, else from python/ beside the executable, as scripts/setup builds it), was
+    built with `binary` (default_mcrt()) and not before its library; not with `cli`. Returns where it was imported
+    from, or None when renders stay commands."""
+    if cli:
+        return None
+    binary = os.path.realpath(mcrt_binary(binary))
+    module = None
+    try:
+        import mcrt as module
+    except ImportError:
+        beside = Path(binary).parent / "python"
+        if (beside / "mcrt" / "__init__.py").is_file():
+            sys.path.insert(0, str(beside))
+            try:
+                import mcrt as module
+            except ImportError:
+                sys.path.remove(str(beside))
+    if module is None:
+        return None
+    # build/python/mcrt/__init__.py belongs to build/mcrt
+    built_with = Path(module.__file__).resolve().parents[2] / "mcrt"
+    if os.path.realpath(built_with) != binary:
+        print("%s: the module %s is not %s's: rendering with commands"
+              % (os.path.basename(sys.argv[0]), module.__file__, binary), file=sys.stderr)
+        return None
+    # A module linked before the library it shares with the executable (only `mcrt` rebuilt
+    # after a change) would render with the old kernels.
+    core = Path(binary).parent / "libmcrt_core.a"
+    extension = Path(module._mcrt.__file__)
+    if core.is_file() and extension.stat().st_mtime < core.stat().st_mtime:
+        print("%s: the module %s is older than %s (cmake --build %s --target mcrt_python): "
+              "rendering with commands" % (os.path.basename(sys.argv[0]), extension, core,
+                                           Path(binary).parent), file=sys.stderr)
+        return None
+    _MODULE.update(module=module, binary=binary)
+    print("%s: rendering through the Python module in %s (--cli: a command per render)"
+          % (os.path.basename(sys.argv[0]), os.path.dirname(os.path.dirname(module.__file__))),
+          file=sys.stderr)
+    return os.path.dirname(module.__file__)
+
+
+def _module_for(binary):
+    """The module when use_module chose it for this executable; None otherwise."""
+    if _MODULE["module"] is None or os.path.realpath(binary) != _MODULE["binary"]:
+        return None
+    return _MODULE["module"]
+
+
+def _render_in_module(scene, stem, words, command):
+    """What `command` (mcrt render SCENE --out STEM.exr --stats STEM.json --quiet WORDS) does,
+    through the module: the scene loaded once per (devices, materials), WORDS read by the
+    command's own parser. ScriptError, naming the command, for what the command would refuse."""
+    mcrt = _MODULE["module"]
+    taken, rest, i = {}, [], 0
+    while i < len(words):
+        name, equals, value = words[i].partition("=")
+        if name in _LOAD_OPTIONS:
+            if not equals:
+                if i + 1 >= len(words):
+                    raise ScriptError("%s: %s needs a value" % (shlex.join(command), name))
+                value = words[i + 1]
+                i += 1
+            taken.setdefault(name, []).append(value)
+        else:
+            rest.append(words[i])
+        i += 1
+    devices = tuple(taken.get("--device", []))
+    materials = taken.get("--materials", ["gltf"])[-1]
+    try:
+        context = _MODULE["contexts"].get(devices)
+        if context is None:
+            context = _MODULE["contexts"][devices] = mcrt.Context(list(devices) or None)
+        key = (devices, str(scene), materials)
+        loaded = _MODULE["scenes"].get(key)
+        if loaded is None:
+            loaded = _MODULE["scenes"][key] = context.load(str(scene), materials)
+        # The command's words as they are, to the command's parser (Scene.render's keywords
+        # become these words too).
+        result = loaded._scene._render(rest, None, None)
+        png = taken.get("--png", [""])[-1]
+        exposure = float(taken.get("--exposure", ["0"])[-1])
+        result.save(stem + ".exr", png=png, exposure=exposure)
+    except (ValueError, RuntimeError) as e:  # the module's errors: the command's one line
+        raise ScriptError("%s: %s" % (shlex.join(command), str(e).split("\n")[0]))
+    Path(stem + ".json").write_text(json.dumps(result.stats, indent=2) + "\n")
 
 
 def read_image_file(path):
