@@ -13,6 +13,8 @@
 #include <utility>
 #include <vector>
 
+#include "common/stop_signals.h"
+
 namespace mcrt {
 
 // Work that runs on a thread of its own while the calling thread, which holds the GIL between
@@ -25,7 +27,7 @@ namespace mcrt {
 // which python/mcrt/__init__.py registers with atexit).
 struct Job {
     // Set by the calling thread, read by the work's: the render's RenderControl::interrupted.
-    volatile std::sig_atomic_t interrupted = 0;
+    StopFlag interrupted{0};
     std::mutex mutex;
     std::condition_variable changed;
     bool done = false;                                // under mutex

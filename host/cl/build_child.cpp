@@ -31,7 +31,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const volatile std::sig_atomic_t* g_stop_flag = nullptr;
+const StopFlag* g_stop_flag = nullptr;
 
 std::string read_text(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
@@ -122,7 +122,7 @@ std::string last_line(const std::string& text) {
 
 }  // namespace
 
-void set_build_stop_flag(const volatile std::sig_atomic_t* flag) { g_stop_flag = flag; }
+void set_build_stop_flag(const StopFlag* flag) { g_stop_flag = flag; }
 
 const std::string& build_child_executable() {
     static const std::string path = [] {

@@ -11,6 +11,7 @@
 
 #include "cl/device.h"
 #include "common/error.h"
+#include "common/stop_signals.h"
 
 namespace mcrt {
 
@@ -32,7 +33,7 @@ std::vector<unsigned char> build_binary_in_child(const DeviceInfo& device,
                                                  const std::string& options);
 
 // A flag that a signal handler raises to stop the render: child builds watch it.
-void set_build_stop_flag(const volatile std::sig_atomic_t* flag);
+void set_build_stop_flag(const StopFlag* flag);
 
 // The child's side: `mcrt build-program DIR DEVICE_INDEX` builds DIR/source.cl with the options
 // in DIR/options for the device and writes DIR/binary, or the error to DIR/error (exit 3 for a

@@ -41,7 +41,7 @@
 namespace mcrt {
 namespace {
 
-volatile std::sig_atomic_t g_interrupted = 0;
+StopFlag g_interrupted{0};
 
 extern "C" void on_interrupt(int) { g_interrupted = 1; }
 

@@ -4,7 +4,7 @@ namespace mcrt {
 
 namespace {
 volatile std::sig_atomic_t g_outputs_complete = 0;
-const volatile std::sig_atomic_t* g_stop_flag = nullptr;
+const StopFlag* g_stop_flag = nullptr;
 
 // Read during static initialisation, before main and before any OpenCL library is loaded.
 const bool g_hangup_ignored = [] {
@@ -13,7 +13,7 @@ const bool g_hangup_ignored = [] {
 }();
 }  // namespace
 
-void set_stop_flag(const volatile std::sig_atomic_t* flag) { g_stop_flag = flag; }
+void set_stop_flag(const StopFlag* flag) { g_stop_flag = flag; }
 
 bool stop_requested() { return g_stop_flag != nullptr && *g_stop_flag != 0; }
 

@@ -2,6 +2,7 @@
 // (ROBUSTNESS.md "Signals and pipes").
 #pragma once
 
+#include <atomic>
 #include <csignal>
 
 namespace mcrt {
@@ -10,10 +11,16 @@ namespace mcrt {
 // ssh session): each stops a render, which writes the samples done so far.
 inline constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
 
+// A flag that a signal handler raises and other threads read (the render loop, the device
+// threads, a kernel build's wait): a lock-free atomic, which a handler may write (C++17
+// [support.signal]) and threads may read without a data race, as a volatile sig_atomic_t may not.
+using StopFlag = std::atomic<int>;
+static_assert(StopFlag::is_always_lock_free, "a stop flag must be writable from a signal handler");
+
 // The flag a stop signal raises while a render runs (the render's interrupt guard sets it), or
 // nullptr: work that blocks outside the render loop (the output commit's wait for another
 // process's lock) reads it through stop_requested().
-void set_stop_flag(const volatile std::sig_atomic_t* flag);
+void set_stop_flag(const StopFlag* flag);
 bool stop_requested();
 
 // After every output is complete a stop signal has nothing left to save: the stop signals are

@@ -12,6 +12,7 @@
 
 #include "cl/device.h"
 #include "image/image.h"
+#include "common/stop_signals.h"
 #include "render/gpu_scene.h"
 
 namespace mcrt {
@@ -83,7 +84,7 @@ using ProgressSink =
 // and what it keeps beside the image.
 struct RenderControl {
     double time_limit = 0;
-    const volatile std::sig_atomic_t* interrupted = nullptr;
+    const StopFlag* interrupted = nullptr;  // common/stop_signals.h
     // Called once when the kernels are about to run: after the builds and, in an MPI job, the
     // other ranks' setup (the supervisor's time limit counts from here, host/cli/supervisor.h).
     std::function<void()> launching;
