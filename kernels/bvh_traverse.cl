@@ -45,6 +45,14 @@ typedef struct {
 } AlphaTest;
 #endif
 
+/* A packet lane's triangle index without the MCRT_TRIANGLE_CULLED bit (shared_types.h), which
+ * only single-sided builds set; the others mask nothing. */
+#if defined(MCRT_SINGLE_SIDED)
+#define PACKET_INDEX_MASK MCRT_TRIANGLE_INDEX_MASK
+#else
+#define PACKET_INDEX_MASK 0xffffffffu
+#endif
+
 /* A visited inner node pushes at most 3 of its children (the nearest is visited next), and the
  * stack holds entries of at most MCRT_BVH4_MAX_DEPTH (59) levels: 3 · 59 = 177 entries never
  * overflow. The any-hit traversal pushes up to 4 inner children and pops one at once, but only
@@ -203,11 +211,13 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
                 float m = min(m2.x, m2.y);
                 int i = tm.x == m ? 0 : tm.y == m ? 1 : tm.z == m ? 2 : 3;
                 int4 at_m = lanes & (tm == (float4)(m));
-                uint mi = pk->index[i];
+                uint mi = pk->index[i] & PACKET_INDEX_MASK;
                 /* Ties (two lanes at m, or m at the held t) are rare: a branch that is almost
                  * never taken, where the index compares on every packet cost 10-20%. */
                 if (-(at_m.x + at_m.y + at_m.z + at_m.w) > 1) {
-                    uint4 idx = select((uint4)(UINT_MAX), vload4(0, pk->index), as_uint4(at_m));
+                    uint4 idx = select((uint4)(UINT_MAX),
+                                       vload4(0, pk->index) & (uint4)(PACKET_INDEX_MASK),
+                                       as_uint4(at_m));
                     uint2 i2 = min(idx.xy, idx.zw);
                     mi = min(i2.x, i2.y);
                     i = idx.x == mi ? 0 : idx.y == mi ? 1 : idx.z == mi ? 2 : 3;

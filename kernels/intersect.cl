@@ -95,7 +95,8 @@ inline float4 packet_t_rounding_bound(const ShearedPacket* s, float4 az, float4 
  * t in (δt, t_max − δt): a ray leaving a surface cannot then hit that surface's plane again
  * however large its triangles, nor a shadow ray the light's plane it ends at. The closest hit
  * checks its one winner instead (bvh_closest_hit). Lanes in `skip` are the triangle a ray
- * leaves: a flat triangle cannot be hit again by a ray leaving it. Forced inline: PoCL's inliner
+ * leaves: a flat triangle cannot be hit again by a ray leaving it. With -D MCRT_SINGLE_SIDED a
+ * lane marked MCRT_TRIANGLE_CULLED is not hit from behind, in every query alike. Forced inline: PoCL's inliner
  * prices it just over its threshold (565 against 562) and called it, which cost the closest hit
  * about 10% (docs/BENCHMARKS.md). */
 inline __attribute__((always_inline)) int4 intersect_packet(const PacketRay* q,
@@ -125,6 +126,12 @@ inline __attribute__((always_inline)) int4 intersect_packet(const PacketRay* q,
     int4 positive = (u > 0.0f) | (v_ > 0.0f) | (w_ > 0.0f);
     float4 det = u + v_ + w_;
     int4 hit = used & ~(negative & positive) & (det != 0.0f);
+#if defined(MCRT_SINGLE_SIDED)
+    /* A single-sided lane is hit from its front only: det > 0 where the ray meets the
+     * counter-clockwise side (glTF 2.0 sec. 3.9.2, back-face culling; Woop et al. 2013, sec. 3,
+     * BACKFACE_CULLING; the swap of x and y for dir.z < 0 keeps the sign). */
+    hit &= ~((as_int4(vload4(0, pk->index)) < (int4)(0)) & (det < 0.0f));
+#endif
     if (!any(hit)) return hit;
 
     float4 az = q->shear_z * s.a_z, bz = q->shear_z * s.b_z, cz = q->shear_z * s.c_z;

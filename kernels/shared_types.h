@@ -99,11 +99,19 @@ typedef struct {
 /* Up to four triangles of one leaf in SoA form, 160 bytes, so that one watertight test in float4
  * arithmetic covers all four (Wald, Benthin, Boulos 2008; Embree's triangle4). v[3k + a] holds
  * coordinate a (x, y, z) of vertex k of the four lanes; index[i] is lane i's triangle in leaf
- * order (the Triangle array), MCRT_NO_HIT for an unused lane, whose vertices are 0. */
+ * order (the Triangle array), MCRT_NO_HIT for an unused lane, whose vertices are 0. In the
+ * device scene (host/render/gpu_scene.cpp) a lane's index also carries MCRT_TRIANGLE_CULLED. */
 typedef struct {
     float4 v[9];    /* 0: x0, y0, z0, x1, y1, z1, x2, y2, z2 */
     uint index[4];  /* 144 */
 } TrianglePacket;
+
+/* Set in a used lane's TrianglePacket.index: the triangle is single-sided (glTF `doubleSided`
+ * false) and not transmissive, so that no ray hits its back face (glTF 2.0 sec. 3.9.2; DESIGN.md
+ * "Radiometric contract"). Only kernels built with -D MCRT_SINGLE_SIDED, for a scene that has
+ * such a triangle, read it; the index proper is the other 31 bits. */
+#define MCRT_TRIANGLE_CULLED 0x80000000u
+#define MCRT_TRIANGLE_INDEX_MASK 0x7fffffffu
 
 /* Triangles per TrianglePacket: the SAH counts a leaf of N triangles as ceil(N / 4) tests. */
 #define MCRT_PACKET_WIDTH 4

@@ -14,7 +14,8 @@ kernel void trace_closest(global const Bvh4Node* nodes, global const TrianglePac
     Hit h = bvh_closest_hit(nodes, packets, &r, origins[g].w, MCRT_NO_HIT, 0);
     uint triangle = h.lane == MCRT_NO_HIT
                         ? MCRT_NO_HIT
-                        : packets[h.lane / MCRT_PACKET_WIDTH].index[h.lane % MCRT_PACKET_WIDTH];
+                        : packets[h.lane / MCRT_PACKET_WIDTH].index[h.lane % MCRT_PACKET_WIDTH] &
+                              PACKET_INDEX_MASK;
     hits[g] = (float4)(h.t, h.b1, h.b2, as_float(triangle));
 }
 

@@ -293,7 +293,8 @@ TEST_CASE("no light leaks into a box resting on a large floor, and none is lost 
                                    Placement{1.0, glm::dvec3(1e4, 0.5e4, -0.7e4)}}) {
         Scene scene;
         uint32_t floor = add_material(scene, glm::vec3(kAlbedo));
-        uint32_t wall = add_material(scene, glm::vec3(0.5f));
+        // Double-sided: a single-sided wall is not there from inside the box (glTF's culling).
+        uint32_t wall = add_material(scene, glm::vec3(0.5f), glm::vec3(0.0f), true);
         const double h = 1000;
         auto P = [&](double x, double y, double z) { return glm::vec3(place({x, y, z})); };
         add_quad(scene, P(-h, 0, -h), P(-h, 0, h), P(h, 0, h), P(h, 0, -h), floor);

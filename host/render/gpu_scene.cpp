@@ -213,6 +213,13 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
             gpu::TriangleInfo& info = data.triangle_info[p * MCRT_PACKET_WIDTH + size_t(lane)];
             info.material = scene.triangle_material[scene_triangle];
             info.light = light_of_triangle[scene_triangle];
+            // glTF 2.0 sec. 3.9.2: a single-sided surface is back-face culled, for every ray;
+            // never a transmissive one, whose back faces rays inside its volume meet.
+            const Material& m = scene.materials[info.material];
+            if (!m.double_sided && !(m.transmission > 0.0f)) {
+                data.packets[p].index[lane] |= MCRT_TRIANGLE_CULLED;
+                data.single_sided = true;
+            }
         }
     }
     if (data.textured) {

@@ -37,6 +37,9 @@ struct GpuSceneData {
     // Some material transmits (Material::transmission > 0): the kernels need the dielectric
     // BTDF and the path's handling of what light strategies cannot reach (-D MCRT_TRANSMISSION).
     bool transmission = false;
+    // Some triangle is single-sided and not transmissive: its packet lane carries
+    // MCRT_TRIANGLE_CULLED and the kernels cull its back face (-D MCRT_SINGLE_SIDED).
+    bool single_sided = false;
     // Some material has a texture or tests alpha (Material::textured): the kernels need texture
     // lookups (-D MCRT_TEXTURES), and these two arrays; an untextured scene leaves them empty.
     bool textured = false;

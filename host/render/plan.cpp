@@ -66,7 +66,7 @@ RenderPlan check_render_settings(RenderSettings settings, const std::optional<gl
 RenderPlan finish_render_plan(RenderPlan plan, const GpuSceneData& scene) {
     const RenderSettings& s = plan.settings;
     plan.program_options = variant_program_options(plan.variants, scene.microfacet, scene.textured,
-                                                   scene.transmission);
+                                                   scene.transmission, scene.single_sided);
     plan.fixed_batch =
         s.batch > 0 ? uint64_t(s.width) * uint64_t(s.height) *
                           batch_samples_per_pixel(s.batch, s.width, s.height, s.spp)
