@@ -122,7 +122,8 @@ RenderVariants resolve_variants(const RenderSettings& settings);
 // (-D MCRT_TEXTURES); `transmission`: a transmissive material (-D MCRT_TRANSMISSION, with the
 // glTF model only).
 std::string variant_program_options(const RenderVariants& variants, bool microfacet,
-                                    bool textured, bool transmission = false);
+                                    bool textured, bool transmission = false,
+                                    bool environment_map = false);
 
 // The rows' names, in table order (CLI11's IsMember, --help, the tests).
 template <typename Row>
