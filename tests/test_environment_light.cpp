@@ -4,6 +4,8 @@
 // `mcrt render --env` refuses the hostile files with one line and exit 2.
 #include <sys/stat.h>
 
+#include <nlohmann/json.hpp>
+
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
@@ -298,10 +300,15 @@ TEST_CASE("mcrt render --env refuses hostile maps with one line and exit 2",
     const std::string one = write_map(dir, "one.exr", 1, 1, [](int, int, int) { return 1.0f; });
     ProcessResult r = run_process(MCRT_EXE,
                                   {"render", scene, "--env", one, "--width", "8", "--height", "8",
-                                   "--spp", "4", "--quiet", "--out", dir / "a.exr"},
+                                   "--spp", "4", "--quiet", "--out", dir / "a.exr", "--stats",
+                                   dir / "a.json"},
                                   dir.path(), 60);
     INFO(r.err);
-    CHECK(r.exit_code == 0);
+    REQUIRE(r.exit_code == 0);
+    // The stats name the map; without area lights the light strategies choose it always.
+    const nlohmann::json stats = nlohmann::json::parse(read_whole_file(dir / "a.json"));
+    CHECK(stats["env"] == one);
+    CHECK(stats["env_light_pmf"] == 1.0);
     r = run_process(
         MCRT_EXE, {"render", scene, "--env", one, "--sky", "1", "--quiet", "--out", dir / "b.exr"},
         dir.path(), 30);
