@@ -4,12 +4,11 @@
 // `mcrt render --env` refuses the hostile files with one line and exit 2.
 #include <sys/stat.h>
 
-#include <nlohmann/json.hpp>
-
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "analytic_scenes.h"
 #include "device_support.h"
@@ -298,11 +297,11 @@ TEST_CASE("mcrt render --env refuses hostile maps with one line and exit 2",
     }
     // A 1 × 1 map is a uniform sky: it renders. --sky with --env is a usage error.
     const std::string one = write_map(dir, "one.exr", 1, 1, [](int, int, int) { return 1.0f; });
-    ProcessResult r = run_process(MCRT_EXE,
-                                  {"render", scene, "--env", one, "--width", "8", "--height", "8",
-                                   "--spp", "4", "--quiet", "--out", dir / "a.exr", "--stats",
-                                   dir / "a.json"},
-                                  dir.path(), 60);
+    ProcessResult r =
+        run_process(MCRT_EXE,
+                    {"render", scene, "--env", one, "--width", "8", "--height", "8", "--spp", "4",
+                     "--quiet", "--out", dir / "a.exr", "--stats", dir / "a.json"},
+                    dir.path(), 60);
     INFO(r.err);
     REQUIRE(r.exit_code == 0);
     // The stats name the map; without area lights the light strategies choose it always.
