@@ -18,6 +18,7 @@
 #include "render/environment_light.h"
 #include "render/plan.h"
 #include "scene_builders.h"
+#include "test_support.h"
 
 using namespace mcrt;
 using namespace mcrt::test;
@@ -313,4 +314,31 @@ TEST_CASE("mcrt render --env refuses hostile maps with one line and exit 2",
         dir.path(), 30);
     CHECK(r.exit_code == 2);
     CHECK(lines_starting_with(r.err, "mcrt: error:").size() == 1);
+}
+
+TEST_CASE(
+    "an estimator file written for environment_radiance(scene) is told the call takes the "
+    "direction",
+    "[environment][estimator-file]") {
+    TempDir dir("mcrt-env");
+    const std::string file = dir / "old.cl";
+    {
+        std::ofstream out(file);
+        out << "float3 estimate(const SceneView* scene, const SurfacePoint* sp,\n"
+               "                const SampleStream* stream, uint* rays) {\n"
+               "    return environment_radiance(scene);\n"
+               "}\n";
+    }
+    const ProcessResult r = run_process(
+        MCRT_EXE,
+        {"render", scene_path("cornell/CornellBox-Original.gltf"), "--estimator-file", file,
+         "--width", "8", "--height", "8", "--spp", "4", "--quiet", "--out", dir / "a.exr"},
+        dir.path(), 120);
+    INFO(r.err);
+    CHECK(r.exit_code == 2);
+    const std::vector<std::string> errors = lines_starting_with(r.err, "mcrt: error:");
+    REQUIRE(errors.size() == 1);
+    CHECK(errors[0].find(file + ":3: environment_radiance takes (scene, direction)") !=
+          std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(dir / "a.exr"));
 }
