@@ -134,7 +134,7 @@ void check_render_result(const RenderResult& result, const WarningSink& warn) {
 
 std::map<std::string, std::string> exr_attributes(const RenderOptions& o,
                                                   const RenderResult& result) {
-    return {
+    std::map<std::string, std::string> attributes = {
         {"mcrt.scene", o.scene},
         {"mcrt.estimator", o.estimator_file.empty() ? o.estimator : o.estimator_file},
         {"mcrt.light_select", o.light_select},
@@ -148,6 +148,9 @@ std::map<std::string, std::string> exr_attributes(const RenderOptions& o,
              ? "variance of the pixel mean from the spread of " + std::to_string(result.replicates) +
                    " independent replicate means"
              : "variance of the pixel mean: the samples' variance over their number"}};
+    // Only with a map: a render without one keeps its file's bytes.
+    if (!o.env.empty()) attributes["mcrt.env"] = o.env;
+    return attributes;
 }
 
 RenderRequest render_request(const RenderOptions& o) {
