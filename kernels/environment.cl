@@ -46,12 +46,10 @@ typedef struct {
     uint texel;
 } EnvironmentSample;
 
-/* u_select (with u_fine) chooses the texel by the CDF; u uniform in φ and cos θ within it, so
- * uniform in solid angle over the texel (PBRT 4th ed. §12.5.2, with nearest texels). */
-inline EnvironmentSample sample_environment_map(const EnvironmentMapView* env, float u_select,
-                                                float u_fine, float2 u) {
-    DiscreteSample ds =
-        sample_discrete_cdf(env->cdf, env->width * env->height, u_select, u_fine);
+/* The direction of texel choice ds: u uniform in φ and cos θ within the texel, so uniform in
+ * solid angle over it (PBRT 4th ed. §12.5.2, with nearest texels). */
+inline EnvironmentSample environment_texel_direction(const EnvironmentMapView* env,
+                                                     DiscreteSample ds, float2 u) {
     uint i = ds.index % env->width, j = ds.index / env->width;
     float phi = 2.0f * M_PI_F * ((float)i + u.x) / (float)env->width;
     float cos_top = cospi((float)j / (float)env->height);
@@ -65,6 +63,23 @@ inline EnvironmentSample sample_environment_map(const EnvironmentMapView* env, f
     s.texel = ds.index;
     s.pdf_w = ds.pmf / environment_texel_solid_angle(env, j);
     return s;
+}
+
+/* u_select (with u_fine) chooses the texel by the CDF; u places the direction within it. */
+inline EnvironmentSample sample_environment_map(const EnvironmentMapView* env, float u_select,
+                                                float u_fine, float2 u) {
+    DiscreteSample ds =
+        sample_discrete_cdf(env->cdf, env->width * env->height, u_select, u_fine);
+    return environment_texel_direction(env, ds, u);
+}
+
+/* The same from three numbers, as the light strategies have them: the texel choice's remapped
+ * number (uniform again, discrete.cl) places φ and v places cos θ. */
+inline EnvironmentSample sample_environment_map_reusing(const EnvironmentMapView* env,
+                                                        float u_select, float u_fine, float v) {
+    DiscreteSample ds =
+        sample_discrete_cdf(env->cdf, env->width * env->height, u_select, u_fine);
+    return environment_texel_direction(env, ds, (float2)(ds.u_remap, v));
 }
 
 /* The twin: density with respect to solid angle of drawing direction d (unit, world). */

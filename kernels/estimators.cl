@@ -61,7 +61,7 @@ inline float3 estimate_emitter_along(const SceneView* scene, const SurfacePoint*
         found = trace_bsdf_sample(scene, sp, &bs, rays, &seen);
     else
         found = trace_from(scene, sp, wi, rays, &seen);
-    float3 Le = found ? emitted_radiance(&seen) : environment_radiance(scene);
+    float3 Le = found ? emitted_radiance(&seen) : environment_radiance(scene, wi);
     return bsdf_eval(sp, wi) * Le * (w.z / pdf_w);
 }
 
@@ -93,7 +93,7 @@ inline float3 estimate_bsdf(const SceneView* scene, const SurfacePoint* sp,
     SurfacePoint seen;
     bool found = trace_bsdf_sample(scene, sp, &bs, rays, &seen);
     if (!bsdf_sample_is_direct(&bs)) return (float3)(0.0f); /* the path counts what it finds */
-    float3 Le = found ? emitted_radiance(&seen) : environment_radiance(scene);
+    float3 Le = found ? emitted_radiance(&seen) : environment_radiance(scene, bs.wi);
     return bs.f * Le * (bs.cos_theta / bs.pdf_w);
 }
 
@@ -134,8 +134,8 @@ inline float3 estimate_mis(const SceneView* scene, const SurfacePoint* sp,
             }
         } else if (scene->env.sky_pmf > 0.0f) {
             float pdf_light = pdf_light_sky(scene, sp, bs.wi);
-            L +=
-                bs.f * scene->env.sky * (bs.cos_theta / bs.pdf_w * mis_weight(bs.pdf_w, pdf_light));
+            L += bs.f * environment_radiance(scene, bs.wi) *
+                 (bs.cos_theta / bs.pdf_w * mis_weight(bs.pdf_w, pdf_light));
         }
     }
     return L;
@@ -151,8 +151,14 @@ inline float3 estimate_sky_visibility(const SceneView* scene, const SurfacePoint
     if (!(pdf_w > 0.0f) || w.z <= 0.0f) return (float3)(0.0f);
     Frame frame = frame_from_normal(sp->n);
     float t_max = scene->env.ao_distance > 0.0f ? scene->env.ao_distance : MAXFLOAT;
-    if (!escapes(scene, sp, frame_to_world(&frame, w), t_max, rays)) return (float3)(0.0f);
-    return surface_albedo(sp) * scene->env.sky * (MCRT_INV_PI * w.z / pdf_w);
+    float3 wi = frame_to_world(&frame, w);
+    if (!escapes(scene, sp, wi, t_max, rays)) return (float3)(0.0f);
+#if defined(MCRT_ENVIRONMENT_MAP)
+    float3 L_sky = environment_radiance(scene, wi); /* the map as the sky */
+#else
+    float3 L_sky = scene->env.sky;
+#endif
+    return surface_albedo(sp) * L_sky * (MCRT_INV_PI * w.z / pdf_w);
 }
 
 inline float3 estimate_ambient_uniform(const SceneView* scene, const SurfacePoint* sp,

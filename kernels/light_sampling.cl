@@ -93,6 +93,28 @@ inline bool select_sky(const SceneView* scene, float* u, float* u_fine) {
     return false;
 }
 
+#if defined(MCRT_ENVIRONMENT_MAP)
+/* Chooses between the environment map, with probability env.sky_pmf = m·2^-24 for a whole m
+ * (the host's environment_pmf_steps), and the area lights, as select_sky does for any m: k, the
+ * grid value of *u, below m chooses the map. The position within the chosen run of m (or 2^24 − m)
+ * grid values, (k − first + u_fine)/count, is read back onto the grid as k' and u_fine' in integer
+ * arithmetic: K = (k − first)·2^24 + ⌊u_fine·2^24⌋ takes each of its count·2^24 values with equal
+ * probability, so k' = ⌊K/count⌋ is exactly uniform on the grid and u_fine' = (K mod count + ½)/count
+ * refines it. */
+inline bool select_environment(const SceneView* scene, float* u, float* u_fine) {
+    uint m = (uint)(scene->env.sky_pmf * 16777216.0f);
+    if (m == 0u) return false;
+    if (m >= 0x1000000u) return true; /* the map alone: u and u_fine as they are */
+    uint k = unit_to_grid(*u);
+    bool env = k < m;
+    uint first = env ? 0u : m, count = env ? m : 0x1000000u - m;
+    ulong K = ((ulong)(k - first) << 24) | (ulong)unit_to_grid(*u_fine);
+    *u = (float)(uint)(K / count) * 0x1.0p-24f;
+    *u_fine = fmin(((float)(uint)(K % count) + 0.5f) / (float)count, 0x1.fffffep-1f);
+    return env;
+}
+#endif
+
 /* Probability that the light strategies choose among the area lights. */
 inline float area_lights_pmf(const SceneView* scene) { return 1.0f - scene->env.sky_pmf; }
 
@@ -138,6 +160,7 @@ typedef struct {
     Light light;   /* the area light chosen, when `area` */
     float pmf;     /* probability of the choice, the split with the sky included */
     float2 u;      /* the rest of the sample, uniform again */
+    float u_fine;  /* u.x's refinement below the 2^-24 grid, for the environment map's texel */
     uint index;    /* the area light's index */
     bool sky;      /* the sky light was chosen */
     bool area;     /* an area light was chosen; neither: nothing can be sampled */
@@ -148,13 +171,23 @@ inline LightChoice choose_light(const SceneView* scene, const SurfacePoint* sp, 
     LightChoice c;
     c.sky = c.area = false;
     c.pmf = 0.0f;
+    c.u_fine = 0.0f;
     c.index = 0u;
     float u_select = u.x; /* a vector's element has no address in OpenCL C */
+#if defined(MCRT_ENVIRONMENT_MAP)
+    if (select_environment(scene, &u_select, &u_fine)) {
+        c.sky = true;
+        c.u = (float2)(u_select, u.y);
+        c.u_fine = u_fine;
+        return c;
+    }
+#else
     if (select_sky(scene, &u_select, &u_fine)) {
         c.sky = true;
         c.u = (float2)(u_select, u.y);
         return c;
     }
+#endif
     c.u = (float2)(u_select, u.y);
     if (scene->lights.light_count == 0u) return c;
     DiscreteSample choice = select_light(&scene->lights, sp->p, sp->n, u_select, u_fine);
@@ -172,12 +205,41 @@ inline float chosen_light_pmf(const SceneView* scene, const SurfacePoint* sp, ui
     return light_pmf(&scene->lights, sp->p, sp->n, index) * area_lights_pmf(scene);
 }
 
+#if defined(MCRT_ENVIRONMENT_MAP)
+/* A direction toward the environment map by its texel distribution (environment.cl): c.u.x with
+ * c.u_fine chooses the texel, its remapped number and c.u.y the direction within it; density in
+ * solid angle, the map's pmf in the selection. */
+inline LightSample sample_light_environment(const SceneView* scene, const SurfacePoint* sp,
+                                            const LightChoice* c) {
+    LightSample ls = no_light_sample();
+    const EnvironmentMapView* env = &scene->env.map;
+    EnvironmentSample es = sample_environment_map_reusing(env, c->u.x, c->u_fine, c->u.y);
+    if (!(es.pdf_w > 0.0f)) return ls;
+    ls.wi = es.wi;
+    ls.y = sp->p + ls.wi;
+    ls.n_toward = -ls.wi;
+    ls.Le = (float3)(env->rgb[3u * es.texel], env->rgb[3u * es.texel + 1u],
+                     env->rgb[3u * es.texel + 2u]);
+    ls.pmf = scene->env.sky_pmf;
+    ls.pdf = es.pdf_w;
+    ls.d2 = 1.0f;
+    ls.cos_light = 1.0f;
+    ls.measure = LIGHT_MEASURE_SOLID_ANGLE;
+    ls.light = LIGHT_SKY;
+    ls.valid = true;
+    return ls;
+}
+#define MCRT_SAMPLE_SKY_LIGHT(scene, sp, choice) sample_light_environment(scene, sp, &(choice))
+#else
+#define MCRT_SAMPLE_SKY_LIGHT(scene, sp, choice) sample_light_sky(scene, sp, (choice).u)
+#endif
+
 /* ---- Area strategy: (light, point) with density pmf(light)/area ------------------------------ */
 
 inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint* sp, float2 u,
                                      float u_fine) {
     LightChoice choice = choose_light(scene, sp, u, u_fine);
-    if (choice.sky) return sample_light_sky(scene, sp, choice.u);
+    if (choice.sky) return MCRT_SAMPLE_SKY_LIGHT(scene, sp, choice);
     LightSample ls = no_light_sample();
     if (!choice.area) return ls;
     const Light light = choice.light;
@@ -211,7 +273,7 @@ inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint*
 inline LightSample sample_light_solid_angle(const SceneView* scene, const SurfacePoint* sp,
                                             float2 u_light, float u_fine) {
     LightChoice choice = choose_light(scene, sp, u_light, u_fine);
-    if (choice.sky) return sample_light_sky(scene, sp, choice.u);
+    if (choice.sky) return MCRT_SAMPLE_SKY_LIGHT(scene, sp, choice);
     LightSample ls = no_light_sample();
     if (!choice.area) return ls;
     const Light light = choice.light;
@@ -350,8 +412,12 @@ inline float pdf_light_solid_angle(const SceneView* scene, const SurfacePoint* s
  * no light. */
 inline float pdf_light_sky(const SceneView* scene, const SurfacePoint* sp, float3 wi) {
     if (!(scene->env.sky_pmf > 0.0f)) return 0.0f;
+#if defined(MCRT_ENVIRONMENT_MAP)
+    return scene->env.sky_pmf * environment_map_pdf_w(&scene->env.map, wi);
+#else
     Frame frame = frame_from_normal(sp->n);
     return scene->env.sky_pmf * sample_hemisphere_cosine_pdf_w(frame_to_local(&frame, wi));
+#endif
 }
 
 #endif

@@ -64,10 +64,10 @@ inline float3 path_radiance(const SceneView* scene, const Ray* r, SampleStream* 
     set_alpha_key(scene, stream);
     AlphaTest at = ray_alpha_test(scene, r);
     Hit hit = bvh_closest_hit(scene->nodes, scene->packets, r, MAXFLOAT, MCRT_NO_HIT, &at);
-#if defined(MCRT_AMBIENT_ESTIMATOR)
+#if defined(MCRT_AMBIENT_ESTIMATOR) && !defined(MCRT_ENVIRONMENT_MAP)
     if (hit.lane == MCRT_NO_HIT) return scene->env.sky;
 #else
-    if (hit.lane == MCRT_NO_HIT) return environment_radiance(scene);
+    if (hit.lane == MCRT_NO_HIT) return environment_radiance(scene, normalize(r->dir));
 #endif
     SurfacePoint sp = surface_point(scene, r, &hit);
     record->vertices = 1u;
@@ -108,7 +108,7 @@ inline float3 path_radiance(const SceneView* scene, const Ray* r, SampleStream* 
          * delta): the emitter it hits, or the sky it leaves to. */
         beta *= segment_transmittance(&sp, &bs, found ? length(next.p - sp.p) : MAXFLOAT);
         if (!bsdf_sample_is_direct(&bs))
-            L += beta * (found ? emitted_radiance(&next) : environment_radiance(scene));
+            L += beta * (found ? emitted_radiance(&next) : environment_radiance(scene, bs.wi));
         if (!found) break;
 #else
         if (handed) {

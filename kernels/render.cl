@@ -14,7 +14,8 @@ kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* pa
                    global const TriangleInfo* triangle_info, global const Material* materials,
                    global const Light* lights, global const uint* light_selection,
                    global const TriangleSurface* surfaces, global const uint* textures,
-                   global const CameraGpu* camera, global uint4* samples, RenderParams p) {
+                   global const float* environment, global const CameraGpu* camera,
+                   global uint4* samples, RenderParams p) {
     size_t g = get_global_id(0);
     uint pixel = p.pixel_begin + (uint)(g / p.batch_samples);
     if (pixel >= p.pixel_end) return; /* the global size is rounded up to whole work-groups */
@@ -37,6 +38,14 @@ kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* pa
     scene.env.sky = p.sky.xyz;
     scene.env.ao_distance = p.ao_distance;
     scene.env.sky_pmf = p.sky.w;
+#if defined(MCRT_ENVIRONMENT_MAP)
+    scene.env.map.rgb = environment;
+    scene.env.map.cdf = environment + 3u * p.env_width * p.env_height;
+    scene.env.map.width = p.env_width;
+    scene.env.map.height = p.env_height;
+    scene.env.map.cos_rot = p.env_cos_rot;
+    scene.env.map.sin_rot = p.env_sin_rot;
+#endif
     PathContinuation continuation;
     continuation.given = false;
     scene.continuation = p.max_depth > 1u ? &continuation : 0; /* direct lighting goes no further */

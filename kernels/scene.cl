@@ -4,14 +4,21 @@
 
 #include "bvh_traverse.cl"
 #include "lights.cl"
+#if defined(MCRT_ENVIRONMENT_MAP)
+#include "environment.cl"
+#endif
 
-/* The uniform environment (DESIGN.md "Radiometric contract"): the ambient estimators' sky, or,
- * with --sky and a direct or path estimator, a light at infinity beside the area lights. */
+/* The environment (DESIGN.md "Radiometric contract"): the uniform sky or, in -D
+ * MCRT_ENVIRONMENT_MAP builds, the map of --env; the ambient estimators' sky, or, with a direct or
+ * path estimator, a light at infinity beside the area lights. */
 typedef struct {
     float3 sky;        /* radiance of the uniform sky */
     float ao_distance; /* occlusion range; 0 = unbounded */
-    float sky_pmf;     /* probability that the light strategies choose the sky light; 0: the sky
-                          is no light (light_sampling.cl) */
+    float sky_pmf;     /* probability that the light strategies choose the sky light, a multiple of
+                          2^-24; 0: the sky is no light (light_sampling.cl) */
+#if defined(MCRT_ENVIRONMENT_MAP)
+    EnvironmentMapView map; /* the sky's radiance by direction, in place of `sky` */
+#endif
 } Environment;
 
 typedef struct PathContinuation PathContinuation; /* api.cl */
@@ -179,9 +186,14 @@ inline float3 emitted_radiance(const SurfacePoint* sp) {
     return emits ? sp->material.emission.xyz : (float3)(0.0f);
 }
 
-/* Radiance that a ray leaving the scene sees: the sky when it is a light, else black. */
-inline float3 environment_radiance(const SceneView* scene) {
+/* Radiance that a ray leaving the scene along wi (unit, world) sees: the environment map's texel
+ * there (-D MCRT_ENVIRONMENT_MAP), else the uniform sky when it is a light, else black. */
+inline float3 environment_radiance(const SceneView* scene, float3 wi) {
+#if defined(MCRT_ENVIRONMENT_MAP)
+    return environment_map_radiance(&scene->env.map, wi);
+#else
     return scene->env.sky_pmf > 0.0f ? scene->env.sky : (float3)(0.0f);
+#endif
 }
 
 /* The origin of rays leaving sp on the side of its geometric normal (geometry.cl). */

@@ -330,7 +330,7 @@ typedef struct {
     float4 forward;
 } CameraGpu;
 
-/* The per-render values of the render kernel, passed by value as its last argument, 80 bytes.
+/* The per-render values of the render kernel, passed by value as its last argument, 96 bytes.
  * Values that change per render or per launch live here, never in -D options, so they never
  * trigger a rebuild: a sweep over them reuses one program. */
 typedef struct {
@@ -350,6 +350,9 @@ typedef struct {
     uint max_depth;     /* reflections a path may have (--max-depth); 1: direct lighting */
     uint rr_depth;      /* Russian roulette before reflection k >= rr_depth (--rr-depth) */
     uint light_tree_nodes; /* the light tree's nodes at the head of the selection's buffer */
+    uint env_width, env_height; /* the environment map's texels (-D MCRT_ENVIRONMENT_MAP builds;
+                                   sky.w is then the probability of choosing it) */
+    float env_cos_rot, env_sin_rot; /* its turn about +Y (--env-rotate) */
     uint pad0, pad1;
 } RenderParams;
 
@@ -385,6 +388,10 @@ enum RenderArgument {
                                    builds; a placeholder otherwise) */
     RENDER_ARG_TEXTURES,        /* global const uint*: TextureHeader, MaterialTextures, images,
                                    decode tables, texels (textured builds; else a placeholder) */
+    RENDER_ARG_ENVIRONMENT,     /* global const float*: the environment map's RGB texels (3 per
+                                   texel, row 0 at the zenith) followed by its texel CDF
+                                   (env_width·env_height + 1 entries) (-D MCRT_ENVIRONMENT_MAP
+                                   builds; a placeholder otherwise) */
     RENDER_ARG_CAMERA,          /* global const CameraGpu* */
     RENDER_ARG_SAMPLES,         /* global uint4*: out, one per work-item (the radiance's bits,
                                    the packed PathRecord) */
@@ -439,13 +446,15 @@ enum RenderArgument {
     FIELD(LightTreeNode, flags, 192)                                                            \
     TYPE(CameraGpu, 64, 16) FIELD(CameraGpu, eye, 0) FIELD(CameraGpu, right, 16)                \
     FIELD(CameraGpu, up, 32) FIELD(CameraGpu, forward, 48)                                      \
-    TYPE(RenderParams, 80, 16) FIELD(RenderParams, sky, 0) FIELD(RenderParams, ao_distance, 16) \
+    TYPE(RenderParams, 96, 16) FIELD(RenderParams, sky, 0) FIELD(RenderParams, ao_distance, 16) \
     FIELD(RenderParams, width, 20) FIELD(RenderParams, height, 24) FIELD(RenderParams, seed, 28) \
     FIELD(RenderParams, spp, 32) FIELD(RenderParams, light_count, 36)                           \
     FIELD(RenderParams, pixel_begin, 40) FIELD(RenderParams, pixel_end, 44)                     \
     FIELD(RenderParams, sample_begin, 48) FIELD(RenderParams, batch_samples, 52)                 \
     FIELD(RenderParams, replicates, 56) FIELD(RenderParams, max_depth, 60)                      \
     FIELD(RenderParams, rr_depth, 64) FIELD(RenderParams, light_tree_nodes, 68)                 \
+    FIELD(RenderParams, env_width, 72) FIELD(RenderParams, env_height, 76)                      \
+    FIELD(RenderParams, env_cos_rot, 80) FIELD(RenderParams, env_sin_rot, 84)                   \
     TYPE(ChunkSums, 64, 16) FIELD(ChunkSums, shift, 0) FIELD(ChunkSums, sum, 16)                \
     FIELD(ChunkSums, sum_sq, 32) FIELD(ChunkSums, exponent, 48)
 

@@ -261,6 +261,28 @@ TEST_CASE("mpirun -n 2 renders the path-traced image of one process under the sk
     CHECK(sb["roulette_share"].get<double>() > 0.0);
 }
 
+TEST_CASE("mpirun -n 2 renders the image of one process under an environment map", "[mpi][cli]") {
+    // Rank 0 reads the map and ships its bytes with the scene's: the other rank reads it from
+    // that bundle, never from the disk (a map missing from it is an error there).
+    TempDir dir;
+    Image map(16, 8);
+    for (size_t k = 0; k < map.rgb.size(); ++k) map.rgb[k] = k % 48 < 6 ? 40.0f : 0.3f;
+    write_exr(dir / "map.exr", map);
+    const std::vector<std::string> env = {"--env", dir / "map.exr", "--env-rotate", "20",
+                                          "--max-depth", "3", "--look-from", "0,1,5",
+                                          "--look-at", "0,1,0", "--estimator", "mis"};
+    std::vector<std::string> one_args = render_args(dir / "one.exr", env);
+    ProcessResult one = run_process(MCRT_EXE, one_args, dir.path());
+    INFO("stderr: " << one.err);
+    REQUIRE(one.exit_code == 0);
+    ProcessResult two = run_mpi(2, render_args(dir / "two.exr", env), dir);
+    INFO("stderr: " << two.err);
+    REQUIRE(two.exit_code == 0);
+    Image a = read_exr(dir / "one.exr"), b = read_exr(dir / "two.exr");
+    CHECK(same_bits(a.rgb, b.rgb));
+    CHECK(same_bits(a.variance, b.variance));
+}
+
 TEST_CASE("two ranks of two devices each render the image of one process", "[mpi][cli]") {
     mpirun();
     TempDir dir;

@@ -20,6 +20,6 @@ float3 estimate(const SceneView* scene, const SurfacePoint* sp, const SampleStre
      * counts what the direction finds; counted here too, it would count twice. */
     if (!bsdf_sample_is_direct(&bs)) return (float3)(0.0f);
     /* A direction that leaves the scene sees the sky light (black without --sky). */
-    float3 Le = found ? emitted_radiance(&seen) : environment_radiance(scene);
+    float3 Le = found ? emitted_radiance(&seen) : environment_radiance(scene, bs.wi);
     return bs.f * Le * (bs.cos_theta / bs.pdf_w);
 }

@@ -134,7 +134,7 @@ void check_render_result(const RenderResult& result, const WarningSink& warn) {
 
 std::map<std::string, std::string> exr_attributes(const RenderOptions& o,
                                                   const RenderResult& result) {
-    return {
+    std::map<std::string, std::string> attributes = {
         {"mcrt.scene", o.scene},
         {"mcrt.estimator", o.estimator_file.empty() ? o.estimator : o.estimator_file},
         {"mcrt.light_select", o.light_select},
@@ -148,6 +148,9 @@ std::map<std::string, std::string> exr_attributes(const RenderOptions& o,
              ? "variance of the pixel mean from the spread of " + std::to_string(result.replicates) +
                    " independent replicate means"
              : "variance of the pixel mean: the samples' variance over their number"}};
+    // Only with a map: a render without one keeps its file's bytes.
+    if (!o.env.empty()) attributes["mcrt.env"] = o.env;
+    return attributes;
 }
 
 RenderRequest render_request(const RenderOptions& o) {
@@ -169,6 +172,9 @@ RenderRequest render_request(const RenderOptions& o) {
     settings.materials = o.materials;
     if (!o.sky.empty()) r.sky = parse_sky(o.sky);
     settings.ao_distance = o.ao_distance;
+    settings.env = o.env;
+    settings.env_scale = o.env_scale;
+    settings.env_rotate = o.env_rotate;
     settings.max_depth = o.max_depth;
     settings.rr_depth = o.rr_depth;
     settings.seed = o.seed;
@@ -211,6 +217,9 @@ std::vector<std::string> render_option_words(const RenderOptions& o) {
             "--materials " + o.materials,
             "--seed " + std::to_string(o.seed),
             text("--sky", o.sky),
+            text("--env", o.env),
+            "--env-scale " + number("%.9g", o.env_scale),
+            "--env-rotate " + number("%.9g", o.env_rotate),
             "--max-depth " + std::to_string(o.max_depth),
             "--rr-depth " + std::to_string(o.rr_depth),
             "--ao-distance " + number("%.9g", o.ao_distance),
@@ -264,9 +273,25 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
         ->capture_default_str()
         ->check(CLI::IsMember(variant_names(kMaterialVariants)));
     cmd->add_option("--seed", o.seed, "random seed")->capture_default_str();
-    cmd->add_option("--sky", o.sky,
-                    "uniform sky radiance R,G,B: the ambient estimators' sky (default 1), or a "
-                    "light at infinity for the others (default: none, black)");
+    CLI::Option* sky =
+        cmd->add_option("--sky", o.sky,
+                        "uniform sky radiance R,G,B: the ambient estimators' sky (default 1), or a "
+                        "light at infinity for the others (default: none, black)");
+    cmd->add_option("--env", o.env,
+                    "environment map (.exr or .hdr, latitude-longitude, Mitsuba's envmap for +Y "
+                    "up) in place of --sky: the ambient estimators' sky, or a light at infinity "
+                    "for the others, sampled by its texels")
+        ->excludes(sky);
+    cmd->add_option("--env-scale", o.env_scale, "multiplies the environment map's texels")
+        ->capture_default_str()
+        ->check(kFiniteFloat)
+        ->check(CLI::Range(0.0f, 1e30f));
+    cmd->add_option("--env-rotate", o.env_rotate,
+                    "turns the environment map about +Y by this many degrees (counter-clockwise "
+                    "seen from above)")
+        ->capture_default_str()
+        ->check(kFiniteFloat)
+        ->check(CLI::Range(-36000.0f, 36000.0f));
     cmd->add_option("--max-depth", o.max_depth,
                     "reflections per path: 1 direct lighting, 0 emitted light only, up to " +
                         std::to_string(MCRT_MAX_PATH_DEPTH) + " path tracing")
@@ -321,6 +346,7 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     outputs.add("--stats", o.stats);
     std::vector<std::string> inputs = {o.scene};
     if (!o.estimator_file.empty()) inputs.push_back(o.estimator_file);
+    if (!o.env.empty()) inputs.push_back(o.env);
     outputs.prepare(inputs);
     if (!o.estimator_file.empty()) report_to_supervisor("estimator " + o.estimator_file);
     const RenderRequest request = render_request(o);
@@ -334,7 +360,7 @@ int render_here(const RenderOptions& o, RenderJob* job) {
     const std::shared_ptr<SessionScene> scene =
         load_session_scene(request.scene, checked.settings.materials,
                            checked.variants.light_select->id, source, print_warning);
-    const RenderPlan plan = plan_session_render(*scene, request, print_warning);
+    const RenderPlan plan = plan_session_render(*scene, request, print_warning, source);
     const RenderSettings& settings = plan.settings;
     outputs.check_inputs(inputs);  // its buffers too
     check_host_memory("a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " render",

@@ -25,6 +25,8 @@ struct RenderOptions {
     uint32_t seed = 0;
     std::string sky;  // "": not given (the ambient estimators' sky is 1, the others have none)
     float ao_distance = 0.0f;
+    std::string env;  // "": none (RenderSettings::env)
+    float env_scale = 1.0f, env_rotate = 0.0f;
     uint32_t max_depth = 1, rr_depth = 5;
     int camera = -1;
     CameraOptions look;  // --look-from ...: replaces the scene's camera

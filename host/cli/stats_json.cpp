@@ -43,6 +43,12 @@ nlohmann::json render_stats_json(const RenderStatsInput& in) {
         {"microfacet", gpu_scene.microfacet},
         {"sky", {settings.sky.r, settings.sky.g, settings.sky.b}},
         {"sky_light", settings.sky_light},
+        // The environment map (--env; "" for none) and the probability that the light strategies
+        // choose it (RenderPlan::environment_steps).
+        {"env", settings.env},
+        {"env_scale", settings.env_scale},
+        {"env_rotate", settings.env_rotate},
+        {"env_light_pmf", double(in.plan.environment_steps) / 16777216.0},
         {"ao_distance", o.ao_distance},
         {"max_depth", settings.max_depth},
         {"rr_depth", settings.rr_depth},

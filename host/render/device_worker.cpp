@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <thread>
@@ -43,7 +44,7 @@ constexpr double kTargetLaunchSeconds = 0.15;
 }  // namespace
 
 void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene,
-                           const cl::Buffer& samples) {
+                           const cl::Buffer& environment, const cl::Buffer& samples) {
     CL_CHECK(render.setArg(gpu::RENDER_ARG_NODES, scene.nodes));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_PACKETS, scene.packets));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_TRIANGLE_INFO, scene.triangle_info));
@@ -52,6 +53,7 @@ void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene,
     CL_CHECK(render.setArg(gpu::RENDER_ARG_LIGHT_SELECTION, scene.light_selection));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_SURFACES, scene.surfaces));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_TEXTURES, scene.textures));
+    CL_CHECK(render.setArg(gpu::RENDER_ARG_ENVIRONMENT, environment));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_CAMERA, scene.camera));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_SAMPLES, samples));
 }
@@ -99,8 +101,31 @@ void DeviceWorker::set_up(const RenderPlan& plan) {
     max_samples_ =
         std::min<uint64_t>(uint64_t(1) << 22, device.info.max_allocation / 4 / sizeof(gpu::float4));
     if (fixed_batch_ > 0) max_samples_ = std::max(max_samples_, fixed_batch_);
+    // The environment map, uploaded for each render (a session keeps the scene, not the map).
+    std::vector<float> env_words(1, 0.0f);
+    if (plan.environment) {
+        const EnvironmentLight& env = *plan.environment;
+        env_words = environment_words(env);
+        environment_width_ = uint32_t(env.map.width);
+        environment_height_ = uint32_t(env.map.height);
+        const double turn = double(env.rotate_deg) * (3.14159265358979323846 / 180.0);
+        environment_cos_ = float(std::cos(turn));
+        environment_sin_ = float(std::sin(turn));
+        environment_pmf_ = float(plan.environment_steps) * 0x1.0p-24f;  // exact: a grid value
+    }
+    const size_t env_bytes = env_words.size() * sizeof(float);
+    if (env_bytes > device.info.max_allocation)
+        throw RuntimeError("the environment map needs " + std::to_string(env_bytes) +
+                           " bytes, more than the " + std::to_string(device.info.max_allocation) +
+                           " bytes device '" + device.info.name + "' can allocate at once");
+    {
+        cl_int status = CL_SUCCESS;
+        environment_ = cl::Buffer(device.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                  env_bytes, env_words.data(), &status);
+        CL_CHECK_STATUS(status, "clCreateBuffer(environment map)");
+    }
     // Samples and, at 16 samples a chunk, their runs' sums (grown on demand when spp < 16).
-    uint64_t needed = buffers_->bytes + max_samples_ * sizeof(gpu::float4) +
+    uint64_t needed = buffers_->bytes + env_bytes + max_samples_ * sizeof(gpu::float4) +
                       (max_samples_ / MCRT_SAMPLES_PER_CHUNK + 1) * settings.replicates *
                           sizeof(gpu::ChunkSums);
     if (needed > device.info.global_memory)
@@ -110,7 +135,7 @@ void DeviceWorker::set_up(const RenderPlan& plan) {
     samples_ = device_buffer(device, CL_MEM_READ_WRITE,
                              round_up(max_samples_, kGroupSize) * sizeof(gpu::float4), "samples");
 
-    bind_render_arguments(render_, *buffers_, samples_);
+    bind_render_arguments(render_, *buffers_, environment_, samples_);
     CL_CHECK(reduce_.setArg(0, samples_));
     CL_CHECK(reduce_.setArg(3, cl_uint(settings.replicates)));
 }
@@ -159,7 +184,13 @@ void DeviceWorker::start(const WorkItem& item) {
 
     gpu::RenderParams params{};
     params.sky = {settings_.sky.r, settings_.sky.g, settings_.sky.b,
-                  sky_light_pmf(settings_, buffers_->light_count)};
+                  environment_.get() && environment_width_ > 0
+                      ? environment_pmf_
+                      : sky_light_pmf(settings_, buffers_->light_count)};
+    params.env_width = environment_width_;
+    params.env_height = environment_height_;
+    params.env_cos_rot = environment_cos_;
+    params.env_sin_rot = environment_sin_;
     params.ao_distance = settings_.ao_distance;
     params.width = uint32_t(settings_.width);
     params.height = uint32_t(settings_.height);

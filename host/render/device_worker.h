@@ -20,7 +20,7 @@ namespace mcrt {
 // Binds the render kernel's buffers in the order of RenderArgument (kernels/shared_types.h); the
 // per-launch RenderParams are set with each launch.
 void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene,
-                           const cl::Buffer& samples);
+                           const cl::Buffer& environment, const cl::Buffer& samples);
 
 class DeviceWorker : public RenderWorker {
   public:
@@ -73,6 +73,11 @@ private:
     cl::Kernel render_, reduce_;
     std::unique_ptr<GpuSceneBuffers> buffers_;
     cl::Buffer samples_, sums_;
+    // The environment map's texels and CDF (RENDER_ARG_ENVIRONMENT; one float without --env),
+    // its size, turn and the probability that the light strategies choose it.
+    cl::Buffer environment_;
+    uint32_t environment_width_ = 0, environment_height_ = 0;
+    float environment_cos_ = 1.0f, environment_sin_ = 0.0f, environment_pmf_ = 0.0f;
     uint64_t sums_capacity_ = 0;  // ChunkSums the sums_ buffer holds
     struct Launch {  // a started item: its result (sums read into it) and its commands' events
         BatchResult result;

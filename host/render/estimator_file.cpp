@@ -1,6 +1,7 @@
 #include "render/estimator_file.h"
 
 #include <cctype>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -93,7 +94,22 @@ std::string error_caused_by(const std::string& log, const std::string& file,
 std::string estimator_build_error(const std::string& log, const std::string& file,
                                   const std::string& source) {
     const std::string error = first_error_in(log, file);
-    return error.empty() ? error_caused_by(log, file, source) : error;
+    if (error.empty()) return error_caused_by(log, file, source);
+    // environment_radiance gained the direction with environment maps: a file written for
+    // environment_radiance(scene) is told what the call is now.
+    const size_t digits = file.size() + 1;
+    const size_t line_number = std::strtoul(error.c_str() + digits, nullptr, 10);
+    std::istringstream lines(source);
+    std::string line;
+    for (size_t k = 0; k < line_number && std::getline(lines, line); ++k) {
+    }
+    if (error.find("too few arguments") != std::string::npos &&
+        line.find("environment_radiance") != std::string::npos)
+        return file + ":" + std::to_string(line_number) +
+               ": environment_radiance takes (scene, direction): the unit world direction the ray "
+               "left the scene along, which an environment map (--env) needs "
+               "(docs/ESTIMATORS.md) (" + error.substr(error.find(": ", digits) + 2) + ")";
+    return error;
 }
 
 std::string read_estimator_file(const std::string& path) {

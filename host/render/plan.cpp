@@ -3,6 +3,7 @@
 #include "common/activity.h"
 
 #include <chrono>
+#include <cmath>
 
 #include "common/error.h"
 
@@ -51,7 +52,17 @@ RenderPlan check_render_settings(RenderSettings settings, const std::optional<gl
                 "tracing under the sky is a sky light with light-area, light-solid-angle, bsdf, "
                 "hemisphere-* or mis");
     // The ambient estimators' sky is 1 unless given; for the others a sky makes it a light.
-    if (sky) {
+    // An environment map takes the sky's place (plan_environment).
+    if (!settings.env.empty()) {
+        if (sky) throw SettingError("env", settings.env + ": --env and --sky both give the sky; give one");
+        if (!std::isfinite(settings.env_scale) || settings.env_scale < 0.0f)
+            throw SettingError("env_scale", std::to_string(settings.env_scale) +
+                                                ": expected a finite number >= 0");
+        if (!std::isfinite(settings.env_rotate))
+            throw SettingError("env_rotate", "expected a finite number of degrees");
+        settings.sky = glm::vec3(v.ambient() ? 1.0f : 0.0f);
+        settings.sky_light = v.uses(kUsesSkyLight);
+    } else if (sky) {
         settings.sky = *sky;
         settings.sky_light = v.uses(kUsesSkyLight) && (sky->r > 0 || sky->g > 0 || sky->b > 0);
     } else {
@@ -63,10 +74,26 @@ RenderPlan check_render_settings(RenderSettings settings, const std::optional<gl
     return plan;
 }
 
+void plan_environment(RenderPlan& plan, const GpuSceneData& scene, const SceneSource& source) {
+    const RenderSettings& s = plan.settings;
+    plan.environment = nullptr;
+    plan.environment_steps = 0;
+    if (s.env.empty()) return;
+    {
+        const Activity activity("loading the environment map");
+        plan.environment =
+            load_environment_light(s.env, s.env_scale, s.env_rotate, source.bundle, source.record);
+    }
+    if (s.sky_light)
+        plan.environment_steps =
+            environment_pmf_steps(*plan.environment, scene, plan.variants.light_select->id);
+}
+
 RenderPlan finish_render_plan(RenderPlan plan, const GpuSceneData& scene) {
     const RenderSettings& s = plan.settings;
     plan.program_options = variant_program_options(plan.variants, scene.microfacet, scene.textured,
-                                                   scene.transmission, scene.single_sided);
+                                                   scene.transmission, scene.single_sided,
+                                                   plan.environment != nullptr);
     plan.fixed_batch =
         s.batch > 0 ? uint64_t(s.width) * uint64_t(s.height) *
                           batch_samples_per_pixel(s.batch, s.width, s.height, s.spp)
@@ -75,9 +102,13 @@ RenderPlan finish_render_plan(RenderPlan plan, const GpuSceneData& scene) {
 }
 
 RenderPlan make_render_plan(const RenderSettings& settings, const GpuSceneData& scene) {
-    RenderPlan plan = check_render_settings(settings, settings.sky);
-    plan.settings.sky = settings.sky;  // the sky as the caller of a device scene chose it
-    plan.settings.sky_light = settings.sky_light;
+    const bool env = !settings.env.empty();
+    RenderPlan plan = check_render_settings(settings, env ? std::nullopt : std::optional(settings.sky));
+    if (!env) {  // the sky as the caller of a device scene chose it
+        plan.settings.sky = settings.sky;
+        plan.settings.sky_light = settings.sky_light;
+    }
+    plan_environment(plan, scene, SceneSource{});
     return finish_render_plan(std::move(plan), scene);
 }
 
@@ -137,6 +168,7 @@ PlannedRender plan_render(const RenderRequest& request, const SceneSource& sourc
     if (warn && v.uses(kUsesLights) && !s.sky_light && r.scene.gpu.lights.empty())
         warn(request.scene + ": no emissive triangles: direct lighting is black" +
              (v.uses(kUsesSkyLight) ? " (--sky R,G,B adds a sky light)" : ""));
+    plan_environment(r.plan, r.scene.gpu, source);
     r.plan = finish_render_plan(std::move(r.plan), r.scene.gpu);
     return r;
 }

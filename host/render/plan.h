@@ -14,6 +14,7 @@
 #include <glm/glm.hpp>
 
 #include "bvh/bvh.h"
+#include "render/environment_light.h"
 #include "render/gpu_scene.h"
 #include "render/renderer.h"
 #include "render/variants.h"
@@ -53,6 +54,11 @@ struct RenderPlan {
     RenderVariants variants;
     std::string program_options;  // the device adds its own (program.h)
     uint64_t fixed_batch = 0;     // samples per launch with --batch; 0: sized by speed
+    // The environment map of settings.env (plan_environment), and the probability in 2^-24 steps
+    // that the light strategies choose it (environment_pmf_steps; 0 for the ambient estimators,
+    // whose sky it is).
+    std::shared_ptr<const EnvironmentLight> environment;
+    uint32_t environment_steps = 0;
 };
 
 // The scene as loaded and prepared for the plan's devices.
@@ -76,6 +82,11 @@ RenderPlan check_render_settings(RenderSettings settings, const std::optional<gl
 // The plan of settings already checked (check_render_settings) for a device scene: its kernel
 // options and launch size.
 RenderPlan finish_render_plan(RenderPlan plan, const GpuSceneData& scene);
+
+// Reads the environment map of plan.settings.env, if any, from `source` (the disk, recording its
+// bytes, or another rank's bundle) and sets how the light strategies choose it for `scene`.
+// Throws InputError naming the file.
+void plan_environment(RenderPlan& plan, const GpuSceneData& scene, const SceneSource& source);
 
 // Both at once, for a device scene built by the caller (tests, library use); settings.sky and
 // sky_light as given.

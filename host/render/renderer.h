@@ -32,6 +32,11 @@ struct RenderSettings {
     glm::vec3 sky{1.0f};        // ambient estimators: uniform sky radiance; else the sky light's
     bool sky_light = false;     // direct and path estimators: the sky is a light (--sky given)
     float ao_distance = 0.0f;   // ambient estimators: occlusion range, 0 = unbounded
+    // An environment map (--env: .exr or .hdr, "" for none) in place of the uniform sky: the
+    // ambient estimators' sky, and for the others a light beside the area lights.
+    std::string env;
+    float env_scale = 1.0f;   // multiplies its texels
+    float env_rotate = 0.0f;  // degrees about +Y, counter-clockwise seen from above
     uint32_t max_depth = 1;     // reflections per path, 0 .. MCRT_MAX_PATH_DEPTH; 1: direct light
     uint32_t rr_depth = 5;      // Russian roulette before reflection k + 1 for every k >= rr_depth
     uint32_t seed = 0;

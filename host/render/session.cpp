@@ -48,7 +48,7 @@ std::shared_ptr<SessionScene> load_session_scene(const std::string& path,
 }
 
 RenderPlan plan_session_render(SessionScene& scene, const RenderRequest& request,
-                               const WarningSink& warn) {
+                               const WarningSink& warn, const SceneSource& source) {
     RenderPlan plan = check_render_settings(request.settings, request.sky);
     if (plan.settings.materials != scene.materials)
         throw SettingError("materials", plan.settings.materials + ": the scene was loaded with " +
@@ -63,6 +63,7 @@ RenderPlan plan_session_render(SessionScene& scene, const RenderRequest& request
     if (warn && v.uses(kUsesLights) && !s.sky_light && prepared.gpu.lights.empty())
         warn(scene.path + ": no emissive triangles: direct lighting is black" +
              (v.uses(kUsesSkyLight) ? " (--sky R,G,B adds a sky light)" : ""));
+    plan_environment(plan, prepared.gpu, source);
     return finish_render_plan(std::move(plan), prepared.gpu);
 }
 

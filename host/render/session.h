@@ -48,8 +48,9 @@ std::shared_ptr<SessionScene> load_session_scene(const std::string& path,
 // (SettingError), the camera chosen (SettingError) into scene.prepared.camera, the warnings of
 // plan_render (no triangles, no lights for an estimator that needs them). The request's
 // materials must be the scene's.
+// The environment map (--env) is read from `source` (the disk unless a bundle is given).
 RenderPlan plan_session_render(SessionScene& scene, const RenderRequest& request,
-                               const WarningSink& warn);
+                               const WarningSink& warn, const SceneSource& source = {});
 
 // The process's one context and in-order queue on the device, made at the first call. Sessions
 // share them: cached_program keeps each program built for a context for the life of the process,

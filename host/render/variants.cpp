@@ -128,7 +128,7 @@ RenderVariants resolve_variants(const RenderSettings& settings) {
 }
 
 std::string variant_program_options(const RenderVariants& v, bool microfacet, bool textured,
-                                    bool transmission, bool single_sided) {
+                                    bool transmission, bool single_sided, bool environment_map) {
     std::string options = std::string("-cl-std=CL1.2 -D MCRT_ESTIMATE=") + v.estimator.function;
     if (v.ambient()) options += " -D MCRT_AMBIENT_ESTIMATOR";
     options += std::string(" -D ") + v.light_select->macro;
@@ -146,6 +146,8 @@ std::string variant_program_options(const RenderVariants& v, bool microfacet, bo
     if (transmission && microfacet && v.materials->macro) options += " -D MCRT_TRANSMISSION";
     // Back-face culling only for a scene with a single-sided, non-transmissive triangle.
     if (single_sided) options += " -D MCRT_SINGLE_SIDED";
+    // Texel lookups and the map's 2D distribution only for a render with --env.
+    if (environment_map) options += " -D MCRT_ENVIRONMENT_MAP";
     return options;
 }
 

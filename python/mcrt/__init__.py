@@ -35,8 +35,9 @@ _OPTIONS = {
     "width": _INT, "height": _INT, "spp": _INT, "seed": _INT, "max_depth": _INT,
     "rr_depth": _INT, "camera": _INT, "batch": _INT, "replicates": _INT,
     "ao_distance": _FLOAT, "fov": _FLOAT, "time_limit": _FLOAT,
+    "env_scale": _FLOAT, "env_rotate": _FLOAT,
     "estimator": _STR, "estimator_file": _STR, "light_select": _STR, "sampler": _STR,
-    "mis_heuristic": _STR,
+    "mis_heuristic": _STR, "env": _STR,
     "sky": _VEC3, "look_from": _VEC3, "look_at": _VEC3, "up": _VEC3,
 }
 

@@ -112,6 +112,46 @@ def test_user_estimator_from_text_gives_the_cli_bytes(ctx, cornell, tmp_path):
     assert np.array_equal(api.image, builtin.image)
 
 
+def write_hdr(path, width, height, texel):
+    """A Radiance .hdr of flat RGBE texels, texel(i, j) -> 4 bytes."""
+    with open(path, "wb") as f:
+        f.write(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y %d +X %d\n" % (height, width))
+        for j in range(height):
+            for i in range(width):
+                f.write(bytes(texel(i, j)))
+    return str(path)
+
+
+def test_environment_map_gives_the_cli_bytes(ctx, tmp_path):
+    # A map with a bright band and column, under which a plane shows the map's light; env,
+    # env_scale and env_rotate go the command line's way, and --sky with --env is its error.
+    env = write_hdr(tmp_path / "band.hdr", 16, 8,
+                    lambda i, j: (128, 128, 128, 132 if j == 2 or i == 3 else 129))
+    plane = str(ROOT / "scenes" / "glossy" / "white-metal-plane.gltf")
+    scene = ctx.load(plane)
+    for estimator in ("mis", "bsdf", "ambient-cosine"):
+        api = scene.render(env=env, env_scale=2.0, env_rotate=30, estimator=estimator, seed=1,
+                           **SMALL)
+        path = tmp_path / (estimator + "-api.exr")
+        api.save(str(path))
+        out = tmp_path / (estimator + ".exr")
+        run = subprocess.run([MCRT_EXE, "render", plane, "--out", str(out), "--quiet",
+                              "--env", env, "--env-scale", "2", "--env-rotate", "30",
+                              "--estimator", estimator, "--seed", "1", "--width", "24",
+                              "--height", "24", "--spp", "16"], capture_output=True, text=True)
+        assert run.returncode == 0, run.stderr
+        assert path.read_bytes() == out.read_bytes(), estimator
+        assert api.image.mean() > 0
+    with pytest.raises(mcrt.SettingError) as e:
+        scene.render(env=env, sky=1)
+    assert str(e.value) == cli_error(plane, "--out", "/tmp/unused.exr", "--env", env, "--sky",
+                                     "1")
+    missing = str(tmp_path / "missing.hdr")
+    with pytest.raises(ValueError) as e:
+        scene.render(env=missing, **SMALL)
+    assert str(e.value) == cli_error(plane, "--out", "/tmp/unused.exr", "--env", missing)
+
+
 def test_image_is_a_view_on_the_result(cornell):
     r = cornell.render(**SMALL)
     image, again = r.image, r.image
