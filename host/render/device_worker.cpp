@@ -52,6 +52,7 @@ void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene,
     CL_CHECK(render.setArg(gpu::RENDER_ARG_LIGHT_SELECTION, scene.light_selection));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_SURFACES, scene.surfaces));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_TEXTURES, scene.textures));
+    CL_CHECK(render.setArg(gpu::RENDER_ARG_PUNCTUAL, scene.punctual));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_CAMERA, scene.camera));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_SAMPLES, samples));
 }
@@ -159,7 +160,7 @@ void DeviceWorker::start(const WorkItem& item) {
 
     gpu::RenderParams params{};
     params.sky = {settings_.sky.r, settings_.sky.g, settings_.sky.b,
-                  sky_light_pmf(settings_, buffers_->light_count)};
+                  sky_light_pmf(settings_, buffers_->light_count + buffers_->punctual_count)};
     params.ao_distance = settings_.ao_distance;
     params.width = uint32_t(settings_.width);
     params.height = uint32_t(settings_.height);
@@ -167,6 +168,7 @@ void DeviceWorker::start(const WorkItem& item) {
     params.spp = settings_.spp;
     params.light_count = buffers_->light_count;
     params.light_tree_nodes = buffers_->light_tree_nodes;
+    params.punctual_count = buffers_->punctual_count;
     params.pixel_begin = item.pixel_begin;
     params.pixel_end = item.pixel_end;
     params.sample_begin = sample_begin;

@@ -128,7 +128,7 @@ RenderVariants resolve_variants(const RenderSettings& settings) {
 }
 
 std::string variant_program_options(const RenderVariants& v, bool microfacet, bool textured,
-                                    bool transmission) {
+                                    bool transmission, bool punctual) {
     std::string options = std::string("-cl-std=CL1.2 -D MCRT_ESTIMATE=") + v.estimator.function;
     if (v.ambient()) options += " -D MCRT_AMBIENT_ESTIMATOR";
     options += std::string(" -D ") + v.light_select->macro;
@@ -144,6 +144,9 @@ std::string variant_program_options(const RenderVariants& v, bool microfacet, bo
     // Glass only for a scene that has it, and only in the glTF model (--materials lambert makes
     // every surface opaque).
     if (transmission && microfacet && v.materials->macro) options += " -D MCRT_TRANSMISSION";
+    // Punctual lights only for a scene that has them, and only for estimators that can sample
+    // them (a light selection's strategies); the others cannot see them (DESIGN.md).
+    if (punctual && v.uses(kUsesLightSelection)) options += " -D MCRT_PUNCTUAL";
     return options;
 }
 

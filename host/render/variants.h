@@ -120,9 +120,10 @@ RenderVariants resolve_variants(const RenderSettings& settings);
 // The -D options of the render program for these variants; `microfacet`: the scene has a
 // surface that is not Lambertian; `textured`: a material with a texture or alpha test
 // (-D MCRT_TEXTURES); `transmission`: a transmissive material (-D MCRT_TRANSMISSION, with the
-// glTF model only).
+// glTF model only); `punctual`: KHR_lights_punctual lights (-D MCRT_PUNCTUAL).
 std::string variant_program_options(const RenderVariants& variants, bool microfacet,
-                                    bool textured, bool transmission = false);
+                                    bool textured, bool transmission = false,
+                                    bool punctual = false);
 
 // The rows' names, in table order (CLI11's IsMember, --help, the tests).
 template <typename Row>
