@@ -18,10 +18,11 @@
 /* The measure a LightSample's pdf is expressed in. */
 #define LIGHT_MEASURE_AREA 0u        /* per unit area of the light */
 #define LIGHT_MEASURE_SOLID_ANGLE 1u /* per steradian seen from the shading point */
-/* A delta light (punctual, -D MCRT_PUNCTUAL builds): one direction, no density (pdf 1, the
- * selection's pmf alone); Le is what arrives (I × falloff / d², or a directional light's
- * irradiance), and no BSDF sample can find it, so its MIS weight is 1. POSITION: a point or
- * spot light at y; DIRECTION: a directional light, its shadow ray going to infinity. */
+/* A delta light (punctual, -D MCRT_PUNCTUAL builds): one direction, no density. Its sample reads
+ * as a point of the area measure with pdf 1 and cos_light 1, so that the area formulas give the
+ * estimate f · Le · cosθ_x / (d² · pmf): POSITION, a point or spot light at y, Le its intensity
+ * × the spot's falloff toward x; DIRECTION, a directional light, Le its irradiance, d2 1 and its
+ * shadow ray going to infinity. No BSDF sample can find it, so its MIS weight is 1. */
 #define LIGHT_MEASURE_DELTA_POSITION 2u
 #define LIGHT_MEASURE_DELTA_DIRECTION 3u
 
@@ -30,8 +31,8 @@ typedef struct {
     float3 y;        /* the sampled point on the light */
     float3 y_error;  /* per-component bound on y's distance from the light's plane */
     float3 n_toward; /* the light's geometric normal on the shading point's side (ray offset) */
-    float3 Le;       /* radiance the light emits toward the shading point (a delta light: what
-                        arrives there, LIGHT_MEASURE_DELTA_*) */
+    float3 Le;       /* radiance the light emits toward the shading point (a delta light: its
+                        intensity × falloff, or irradiance: LIGHT_MEASURE_DELTA_*) */
     float pmf;       /* probability of having chosen this light */
     float pdf;       /* density of y given the light, in `measure` */
     float d2;        /* |y − x|² */
@@ -192,9 +193,10 @@ inline float chosen_light_pmf(const SceneView* scene, const SurfacePoint* sp, ui
 /* ---- Punctual lights: the one direction a delta light arrives from -------------------------- */
 
 /* What the chosen punctual light sends to sp: a point or spot light's intensity × the spot's
- * falloff / d² from its position (KHR_lights_punctual's implementation notes), a directional
- * light's irradiance from the direction opposite to where it points. Both strategies sample it
- * alike, with the selection's pmf as the sample's only probability (PBRT 4th ed. 12.1, 12.4). */
+ * falloff from its position, at distance² d2 (KHR_lights_punctual's implementation notes), a
+ * directional light's irradiance from the direction opposite to where it points. Both strategies
+ * sample it alike, with the selection's pmf as the sample's only probability (PBRT 4th ed. 12.1,
+ * 12.4). */
 inline LightSample sample_light_punctual(const SceneView* scene, const SurfacePoint* sp,
                                          const LightChoice* choice) {
     LightSample ls = no_light_sample();
@@ -219,7 +221,7 @@ inline LightSample sample_light_punctual(const SceneView* scene, const SurfacePo
         if (!(falloff > 0.0f)) return ls; /* outside the spot's cone */
         ls.wi = wi;
         ls.y = light->position.xyz;
-        ls.Le = I * (falloff / d2);
+        ls.Le = I * falloff;
         ls.d2 = d2;
         ls.measure = LIGHT_MEASURE_DELTA_POSITION;
     }
@@ -348,17 +350,27 @@ inline LightSample sample_light_solid_angle(const SceneView* scene, const Surfac
 /* ---- Using a light sample ----------------------------------------------------------------------
  */
 
-/* cosθ_x · G / density, in the sample's own measure: cosθ_x cosθ_y / (d² pdf_a pmf) per area,
- * cosθ_x / (pdf_w pmf) per solid angle, cosθ_x / pmf for a delta light (pdf 1), so that
+/* True when the sample's pdf is per unit area: an area light's, and a delta light's, which reads
+ * as a point of pdf 1 (LIGHT_MEASURE_DELTA_*). */
+inline bool light_sample_per_area(const LightSample* ls) {
+#if defined(MCRT_PUNCTUAL)
+    return ls->measure != LIGHT_MEASURE_SOLID_ANGLE;
+#else
+    return ls->measure == LIGHT_MEASURE_AREA;
+#endif
+}
+
+/* cosθ_x · G / density, in the sample's own measure: cosθ_x cosθ_y / (d² pdf_a pmf) per area
+ * (a delta light: cosθ_x / (d² pmf)), cosθ_x / (pdf_w pmf) per solid angle, so that
  * f · Le · weight is the estimate. */
 inline float light_sample_weight(const LightSample* ls, float cos_x) {
-    if (ls->measure == LIGHT_MEASURE_AREA)
+    if (light_sample_per_area(ls))
         return cos_x * ls->cos_light / (ls->d2 * ls->pdf * ls->pmf);
     return cos_x / (ls->pdf * ls->pmf);
 }
 
 /* True for a delta light's sample (punctual lights): no BSDF sample can find it, its MIS weight
- * is 1, and light_sample_pdf_w is the selection's probability alone, no density. */
+ * is 1, and light_sample_pdf_w is no density (pmf · d²). */
 inline bool light_sample_is_delta(const LightSample* ls) {
 #if defined(MCRT_PUNCTUAL)
     return ls->measure >= LIGHT_MEASURE_DELTA_POSITION;
@@ -368,9 +380,9 @@ inline bool light_sample_is_delta(const LightSample* ls) {
 }
 
 /* Density of the sample's direction with respect to solid angle, the selection included (a
- * delta light: its pmf, light_sample_is_delta). */
+ * delta light has none: pmf · d², which Le / it turns into what arrives; light_sample_is_delta). */
 inline float light_sample_pdf_w(const LightSample* ls) {
-    if (ls->measure == LIGHT_MEASURE_AREA)
+    if (light_sample_per_area(ls))
         return light_area_pdf_w(ls->pmf, ls->pdf, ls->d2, ls->cos_light);
     return ls->pdf * ls->pmf;
 }
