@@ -233,7 +233,12 @@ TEST_CASE("every light selection gives the same image of punctual and area light
     DeviceContext device = first_device();
     std::vector<PunctualLight> lights = kPointAndSpot;
     lights.push_back(point_light({1.0f, 0.6f, 0.8f}, {0.5f, 0.5f, 0.5f}));
-    lights.push_back(directional_light({-0.3f, -1.0f, 0.5f}, {0.4f, 0.5f, 0.6f}));
+    // Low from +Z, so that the area lights' shadows fall outside the view (z < -1.7), which
+    // the exact image (no occlusion) assumes.
+    lights.push_back(directional_light({0.0f, -1.0f, -3.0f}, {0.4f, 0.5f, 0.6f}));
+    // A hard-edged spot (inner = outer): the tree must still reach inside its cone.
+    lights.push_back(spot_light({-0.6f, 0.9f, -0.5f}, {0.0f, -1.0f, 0.0f}, {2.0f, 2.0f, 2.0f},
+                                25.0, 25.0));
     const PunctualPlane scene(lights, true);
     RenderSettings settings;
     settings.width = 16;
@@ -248,7 +253,7 @@ TEST_CASE("every light selection gives the same image of punctual and area light
             for (const LightSelectVariant& v : kLightSelectVariants)
                 if (v.name == select) build_light_selection(selected, v.id);
             REQUIRE(selected.lights.size() == 3);
-            REQUIRE(selected.punctual.size() == 4);
+            REQUIRE(selected.punctual.size() == 5);
             const Renders r = independent_renders(device, selected, settings, kRenders, kFirstSeed);
             check_unbiased(r, exact, std::string(estimator) + " / " + select);
             CHECK(r.standard_error.x < 0.03 * exact.x);

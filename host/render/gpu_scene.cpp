@@ -222,9 +222,11 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
             case PunctualType::Point: g.type = PUNCTUAL_POINT; break;
             case PunctualType::Spot:
                 g.type = PUNCTUAL_SPOT;
+                // θ_o = inner, θ_e = outer − inner: the falloff is positive for θ < outer, where
+                // the importance is too (θ_e at least 10⁻³ rad, so that it is when inner = outer).
                 item.cos_o = l.cos_inner;
-                item.cos_e = std::cos(std::acos(double(l.cos_outer)) -
-                                      std::acos(double(l.cos_inner)));
+                item.cos_e = std::cos(std::max(
+                    std::acos(double(l.cos_outer)) - std::acos(double(l.cos_inner)), 1e-3));
                 break;
             case PunctualType::Directional:
                 // The whole scene's box: inside its sphere the importance is 4πr²E / r² = 4πE,

@@ -88,8 +88,8 @@ void warn_unseen_lights(const std::string& scene_path, const RenderPlan& plan,
     const RenderSettings& s = plan.settings;
     const size_t punctual = scene.punctual.size();
     const bool sees_punctual = v.uses(kUsesLightSelection);
-    if (v.uses(kUsesLights) && !s.sky_light && scene.lights.empty() &&
-        (punctual == 0 || !sees_punctual))
+    // One warning at most: the punctual lights' where the estimator cannot see them.
+    if (v.uses(kUsesLights) && !s.sky_light && scene.lights.empty() && punctual == 0)
         warn(scene_path + ": no emissive triangles: direct lighting is black" +
              (v.uses(kUsesSkyLight) ? " (--sky R,G,B adds a sky light)" : ""));
     if (punctual > 0 && !sees_punctual)
