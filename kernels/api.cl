@@ -59,4 +59,12 @@ inline float mis_weight(float pdf_a, float pdf_b) {
 #endif
 }
 
+/* MIS weight of light sample ls against a BSDF strategy of density pdf_bsdf (solid angle) for
+ * its direction: mis_weight(light_sample_pdf_w(ls), pdf_bsdf), and 1 for a delta light, which
+ * the BSDF strategy can never find (PBRT 4th ed. 13.4.2, delta lights). */
+inline float light_sample_mis_weight(const LightSample* ls, float pdf_bsdf) {
+    if (light_sample_is_delta(ls)) return 1.0f;
+    return mis_weight(light_sample_pdf_w(ls), pdf_bsdf);
+}
+
 #endif

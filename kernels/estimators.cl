@@ -100,7 +100,8 @@ inline float3 estimate_bsdf(const SceneView* scene, const SurfacePoint* sp,
 /* ---- Multiple importance sampling -------------------------------------------------------- */
 
 /* One light-area sample and one BSDF sample, each weighted against the other's density
- * (Veach 1997, sec. 9.2; Mitsuba 3's `direct` integrator with one sample of each). */
+ * (Veach 1997, sec. 9.2; Mitsuba 3's `direct` integrator with one sample of each); a punctual
+ * light's sample has weight 1, no BSDF sample finding it. */
 inline float3 estimate_mis(const SceneView* scene, const SurfacePoint* sp,
                            const SampleStream* stream, uint* rays) {
     float3 L = (float3)(0.0f);
@@ -115,7 +116,7 @@ inline float3 estimate_mis(const SceneView* scene, const SurfacePoint* sp,
             float pdf_light = light_sample_pdf_w(&ls);
             float pdf_bsdf = bsdf_pdf_w(sp, ls.wi);
             L += bsdf_eval(sp, ls.wi) * ls.Le *
-                 (cos_x / pdf_light * mis_weight(pdf_light, pdf_bsdf));
+                 (cos_x / pdf_light * light_sample_mis_weight(&ls, pdf_bsdf));
         }
     }
 

@@ -18,18 +18,26 @@
 /* The measure a LightSample's pdf is expressed in. */
 #define LIGHT_MEASURE_AREA 0u        /* per unit area of the light */
 #define LIGHT_MEASURE_SOLID_ANGLE 1u /* per steradian seen from the shading point */
+/* A delta light (punctual, -D MCRT_PUNCTUAL builds): one direction, no density. Its sample reads
+ * as a point of the area measure with pdf 1 and cos_light 1, so that the area formulas give the
+ * estimate f · Le · cosθ_x / (d² · pmf): POSITION, a point or spot light at y, Le its intensity
+ * × the spot's falloff toward x; DIRECTION, a directional light, Le its irradiance, d2 1 and its
+ * shadow ray going to infinity. No BSDF sample can find it, so its MIS weight is 1. */
+#define LIGHT_MEASURE_DELTA_POSITION 2u
+#define LIGHT_MEASURE_DELTA_DIRECTION 3u
 
 typedef struct {
     float3 wi;       /* unit, from the shading point toward y */
     float3 y;        /* the sampled point on the light */
     float3 y_error;  /* per-component bound on y's distance from the light's plane */
     float3 n_toward; /* the light's geometric normal on the shading point's side (ray offset) */
-    float3 Le;       /* radiance the light emits toward the shading point */
+    float3 Le;       /* radiance the light emits toward the shading point (a delta light: its
+                        intensity × falloff, or irradiance: LIGHT_MEASURE_DELTA_*) */
     float pmf;       /* probability of having chosen this light */
     float pdf;       /* density of y given the light, in `measure` */
     float d2;        /* |y − x|² */
     float cos_light; /* cosine at the light between its emitting normal and −wi, > 0 */
-    uint measure;    /* LIGHT_MEASURE_AREA or LIGHT_MEASURE_SOLID_ANGLE */
+    uint measure;    /* LIGHT_MEASURE_AREA, _SOLID_ANGLE or a delta light's _DELTA_* */
     uint light;      /* index of the chosen light; LIGHT_SKY for the sky */
     bool valid;      /* false: the sample adds nothing (no lights, a back face, degenerate) */
 } LightSample;
@@ -161,15 +169,16 @@ typedef struct {
     float pmf;     /* probability of the choice, the split with the sky included */
     float2 u;      /* the rest of the sample, uniform again */
     float u_fine;  /* u.x's refinement below the 2^-24 grid, for the environment map's texel */
-    uint index;    /* the area light's index */
+    uint index;    /* the area light's index (a punctual light's: light_count + its own) */
     bool sky;      /* the sky light was chosen */
     bool area;     /* an area light was chosen; neither: nothing can be sampled */
+    bool punctual; /* a punctual light was chosen (-D MCRT_PUNCTUAL builds) */
 } LightChoice;
 
 inline LightChoice choose_light(const SceneView* scene, const SurfacePoint* sp, float2 u,
                                 float u_fine) {
     LightChoice c;
-    c.sky = c.area = false;
+    c.sky = c.area = c.punctual = false;
     c.pmf = 0.0f;
     c.u_fine = 0.0f;
     c.index = 0u;
@@ -189,9 +198,17 @@ inline LightChoice choose_light(const SceneView* scene, const SurfacePoint* sp, 
     }
 #endif
     c.u = (float2)(u_select, u.y);
-    if (scene->lights.light_count == 0u) return c;
+    if (light_selection_count(&scene->lights) == 0u) return c;
     DiscreteSample choice = select_light(&scene->lights, sp->p, sp->n, u_select, u_fine);
     if (!(choice.pmf > 0.0f)) return c; /* no light can reach sp (the tree) */
+#if defined(MCRT_PUNCTUAL)
+    if (choice.index >= scene->lights.light_count) { /* a delta light: nothing more to draw */
+        c.pmf = choice.pmf * area_lights_pmf(scene);
+        c.index = choice.index;
+        c.punctual = true;
+        return c;
+    }
+#endif
     c.light = scene->lights.lights[choice.index];
     c.pmf = choice.pmf * area_lights_pmf(scene);
     c.u = (float2)(choice.u_remap, u.y);
@@ -234,12 +251,61 @@ inline LightSample sample_light_environment(const SceneView* scene, const Surfac
 #define MCRT_SAMPLE_SKY_LIGHT(scene, sp, choice) sample_light_sky(scene, sp, (choice).u)
 #endif
 
+#if defined(MCRT_PUNCTUAL)
+/* ---- Punctual lights: the one direction a delta light arrives from -------------------------- */
+
+/* What the chosen punctual light sends to sp: a point or spot light's intensity × the spot's
+ * falloff from its position, at distance² d2 (KHR_lights_punctual's implementation notes), a
+ * directional light's irradiance from the direction opposite to where it points. Both strategies
+ * sample it alike, with the selection's pmf as the sample's only probability (PBRT 4th ed. 12.1,
+ * 12.4). */
+inline LightSample sample_light_punctual(const SceneView* scene, const SurfacePoint* sp,
+                                         const LightChoice* choice) {
+    LightSample ls = no_light_sample();
+    global const PunctualGpu* light =
+        scene->lights.punctual + (choice->index - scene->lights.light_count);
+    float3 I = light->intensity.xyz;
+    if (light->type == PUNCTUAL_DIRECTIONAL) {
+        ls.wi = -light->direction.xyz;
+        ls.y = sp->p + ls.wi;
+        ls.Le = I;
+        ls.d2 = 1.0f;
+        ls.measure = LIGHT_MEASURE_DELTA_DIRECTION;
+    } else {
+        float3 to_light = light->position.xyz - sp->p;
+        float d2 = dot(to_light, to_light);
+        if (!(d2 > 0.0f)) return ls;
+        float3 wi = to_light * (1.0f / sqrt(d2));
+        /* clamp(cos θ · scale + offset, 0, 1)², θ from the spot's axis; 1 for a point light. */
+        float t = clamp(-dot(wi, light->direction.xyz) * light->spot_scale + light->spot_offset,
+                        0.0f, 1.0f);
+        float falloff = t * t;
+        if (!(falloff > 0.0f)) return ls; /* outside the spot's cone */
+        ls.wi = wi;
+        ls.y = light->position.xyz;
+        ls.Le = I * falloff;
+        ls.d2 = d2;
+        ls.measure = LIGHT_MEASURE_DELTA_POSITION;
+    }
+    ls.n_toward = -ls.wi;
+    ls.pmf = choice->pmf;
+    ls.pdf = 1.0f;
+    ls.cos_light = 1.0f;
+    ls.light = choice->index;
+    ls.valid = true;
+    return ls;
+}
+#endif
+
 /* ---- Area strategy: (light, point) with density pmf(light)/area ------------------------------ */
 
 inline LightSample sample_light_area(const SceneView* scene, const SurfacePoint* sp, float2 u,
                                      float u_fine) {
     LightChoice choice = choose_light(scene, sp, u, u_fine);
     if (choice.sky) return MCRT_SAMPLE_SKY_LIGHT(scene, sp, choice);
+#if defined(MCRT_PUNCTUAL)
+    if (choice.punctual) return sample_light_punctual(scene, sp, &choice);
+#endif
     LightSample ls = no_light_sample();
     if (!choice.area) return ls;
     const Light light = choice.light;
@@ -274,6 +340,9 @@ inline LightSample sample_light_solid_angle(const SceneView* scene, const Surfac
                                             float2 u_light, float u_fine) {
     LightChoice choice = choose_light(scene, sp, u_light, u_fine);
     if (choice.sky) return MCRT_SAMPLE_SKY_LIGHT(scene, sp, choice);
+#if defined(MCRT_PUNCTUAL)
+    if (choice.punctual) return sample_light_punctual(scene, sp, &choice);
+#endif
     LightSample ls = no_light_sample();
     if (!choice.area) return ls;
     const Light light = choice.light;
@@ -343,17 +412,39 @@ inline LightSample sample_light_solid_angle(const SceneView* scene, const Surfac
 /* ---- Using a light sample ----------------------------------------------------------------------
  */
 
-/* cosθ_x · G / density, in the sample's own measure: cosθ_x cosθ_y / (d² pdf_a pmf) per area,
- * cosθ_x / (pdf_w pmf) per solid angle, so that f · Le · weight is the estimate. */
+/* True when the sample's pdf is per unit area: an area light's, and a delta light's, which reads
+ * as a point of pdf 1 (LIGHT_MEASURE_DELTA_*). */
+inline bool light_sample_per_area(const LightSample* ls) {
+#if defined(MCRT_PUNCTUAL)
+    return ls->measure != LIGHT_MEASURE_SOLID_ANGLE;
+#else
+    return ls->measure == LIGHT_MEASURE_AREA;
+#endif
+}
+
+/* cosθ_x · G / density, in the sample's own measure: cosθ_x cosθ_y / (d² pdf_a pmf) per area
+ * (a delta light: cosθ_x / (d² pmf)), cosθ_x / (pdf_w pmf) per solid angle, so that
+ * f · Le · weight is the estimate. */
 inline float light_sample_weight(const LightSample* ls, float cos_x) {
-    if (ls->measure == LIGHT_MEASURE_AREA)
+    if (light_sample_per_area(ls))
         return cos_x * ls->cos_light / (ls->d2 * ls->pdf * ls->pmf);
     return cos_x / (ls->pdf * ls->pmf);
 }
 
-/* Density of the sample's direction with respect to solid angle, the selection included. */
+/* True for a delta light's sample (punctual lights): no BSDF sample can find it, its MIS weight
+ * is 1, and light_sample_pdf_w is no density (pmf · d²). */
+inline bool light_sample_is_delta(const LightSample* ls) {
+#if defined(MCRT_PUNCTUAL)
+    return ls->measure >= LIGHT_MEASURE_DELTA_POSITION;
+#else
+    return false;
+#endif
+}
+
+/* Density of the sample's direction with respect to solid angle, the selection included (a
+ * delta light has none: pmf · d², which Le / it turns into what arrives; light_sample_is_delta). */
 inline float light_sample_pdf_w(const LightSample* ls) {
-    if (ls->measure == LIGHT_MEASURE_AREA)
+    if (light_sample_per_area(ls))
         return light_area_pdf_w(ls->pmf, ls->pdf, ls->d2, ls->cos_light);
     return ls->pdf * ls->pmf;
 }
@@ -361,7 +452,11 @@ inline float light_sample_pdf_w(const LightSample* ls) {
 /* True if nothing blocks the segment from the shading point to the light sample. */
 inline bool light_sample_visible(const SceneView* scene, const SurfacePoint* sp,
                                  const LightSample* ls) {
-    if (ls->light == LIGHT_SKY) { /* nothing along the ray to infinity */
+    bool at_infinity = ls->light == LIGHT_SKY;
+#if defined(MCRT_PUNCTUAL)
+    at_infinity = at_infinity || ls->measure == LIGHT_MEASURE_DELTA_DIRECTION;
+#endif
+    if (at_infinity) { /* nothing along the ray to infinity */
         Ray r = make_ray(spawn_origin(sp), ls->wi);
         AlphaTest at = ray_alpha_test(scene, &r);
         return !bvh_any_hit(scene->nodes, scene->packets, &r, MAXFLOAT, sp->lane, &at);

@@ -25,8 +25,23 @@ typedef struct {
     global const LightTreeNode* tree;
     global const LightTreePath* paths; /* one per light, after the tree's nodes */
 #endif
-    uint light_count;
+    uint light_count; /* area lights: lights[0, light_count) */
+#if defined(MCRT_PUNCTUAL)
+    /* The punctual lights (shared_types.h, PunctualGpu), the selection's lights light_count + i:
+     * after the area lights in its CDF, alias table and tree. */
+    global const PunctualGpu* punctual;
+    uint punctual_count;
+#endif
 } LightSet;
+
+/* How many lights the selection chooses among: the area lights, then the punctual ones. */
+inline uint light_selection_count(const LightSet* ls) {
+#if defined(MCRT_PUNCTUAL)
+    return ls->light_count + ls->punctual_count;
+#else
+    return ls->light_count;
+#endif
+}
 
 /* The lights and the selection's view of its buffer (shared_types.h, RENDER_ARG_LIGHT_SELECTION:
  * the tree's `tree_nodes` nodes, then the lights' paths). */
@@ -49,24 +64,24 @@ inline LightSet light_set(global const Light* lights, uint light_count,
 /* Selects a light for the shading point p with unit normal n (the side light must arrive
  * from) from u (only the tree reads p and n), refined below the 2^-24 grid by u_fine
  * (discrete.cl); the choice's u_remap is uniform again, for the point on the light.
- * light_count must be > 0. pmf 0 (the tree only): no light can reach p, nothing was chosen. */
+ * light_selection_count must be > 0. pmf 0 (the tree only): no light can reach p, nothing was chosen. */
 inline DiscreteSample select_light(const LightSet* ls, float3 p, float3 n, float u,
                                    float u_fine) {
 #if defined(LIGHT_SELECT_UNIFORM)
-    return sample_discrete_uniform(ls->light_count, u, u_fine);
+    return sample_discrete_uniform(light_selection_count(ls), u, u_fine);
 #elif defined(LIGHT_SELECT_ALIAS)
-    return sample_discrete_alias(ls->alias, ls->light_count, u, u_fine);
+    return sample_discrete_alias(ls->alias, light_selection_count(ls), u, u_fine);
 #elif defined(LIGHT_SELECT_TREE)
     return sample_light_tree(ls->tree, p, n, u, u_fine);
 #else
-    return sample_discrete_cdf(ls->light_cdf, ls->light_count, u, u_fine);
+    return sample_discrete_cdf(ls->light_cdf, light_selection_count(ls), u, u_fine);
 #endif
 }
 
 /* Probability that select_light at (p, n) returns light i. */
 inline float light_pmf(const LightSet* ls, float3 p, float3 n, uint i) {
 #if defined(LIGHT_SELECT_UNIFORM)
-    return 1.0f / (float)ls->light_count;
+    return 1.0f / (float)light_selection_count(ls);
 #elif defined(LIGHT_SELECT_ALIAS)
     return discrete_alias_pmf(ls->alias, i);
 #elif defined(LIGHT_SELECT_TREE)

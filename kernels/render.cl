@@ -14,7 +14,8 @@ kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* pa
                    global const TriangleInfo* triangle_info, global const Material* materials,
                    global const Light* lights, global const uint* light_selection,
                    global const TriangleSurface* surfaces, global const uint* textures,
-                   global const float* environment, global const CameraGpu* camera,
+                   global const float* environment, global const PunctualGpu* punctual,
+                   global const CameraGpu* camera,
                    global uint4* samples, RenderParams p) {
     size_t g = get_global_id(0);
     uint pixel = p.pixel_begin + (uint)(g / p.batch_samples);
@@ -35,6 +36,10 @@ kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* pa
     scene.triangle_info = triangle_info;
     scene.materials = materials;
     scene.lights = light_set(lights, p.light_count, light_selection, p.light_tree_nodes);
+#if defined(MCRT_PUNCTUAL)
+    scene.lights.punctual = punctual;
+    scene.lights.punctual_count = p.punctual_count;
+#endif
     scene.env.sky = p.sky.xyz;
     scene.env.ao_distance = p.ao_distance;
     scene.env.sky_pmf = p.sky.w;

@@ -193,6 +193,25 @@ typedef struct {
     uint surface;      /* its triangle's packet lane (TriangleSurface, TriangleInfo) */
 } Light;
 
+/* PunctualGpu.type: a KHR_lights_punctual light (DESIGN.md "Punctual lights"). */
+#define PUNCTUAL_POINT 0u
+#define PUNCTUAL_SPOT 1u
+#define PUNCTUAL_DIRECTIONAL 2u
+
+/* A punctual light (-D MCRT_PUNCTUAL builds), 64 bytes: a delta light, which the light
+ * selections choose beside the light_count area lights as light light_count + i (its power or
+ * tree slot in the selection's data) and which no ray can hit. */
+typedef struct {
+    float4 position;    /* .xyz world (point, spot); .w 0 */
+    float4 direction;   /* .xyz unit, where the light points (spot, directional); .w 0 */
+    float4 intensity;   /* .xyz color × intensity: radiant intensity (point, spot) or irradiance
+                           (directional); .w 0 */
+    float spot_scale;   /* spot falloff clamp(cos θ · scale + offset, 0, 1)²; point: 0, 1 */
+    float spot_offset;
+    uint type;          /* PUNCTUAL_* */
+    uint pad0;
+} PunctualGpu;
+
 /* Node of the light tree (host/render/light_tree.h), 208 bytes: four slots, each a child node
  * or one light, with the bounds of the lights below it for the importance of
  * kernels/light_tree.cl (Conty Estevez & Kulla 2018; pbrt-v4's LightBounds), laid out as one
@@ -341,7 +360,7 @@ typedef struct {
     uint width, height; /* image size in pixels */
     uint seed;
     uint spp;           /* samples per pixel of the whole render (strata, spiral points) */
-    uint light_count;
+    uint light_count;   /* area lights (emissive triangles) */
     uint pixel_begin, pixel_end; /* this launch: pixels [pixel_begin, pixel_end) */
     uint sample_begin;  /* this launch: samples [sample_begin, sample_begin + batch_samples) */
     uint batch_samples; /*   of each pixel */
@@ -353,7 +372,9 @@ typedef struct {
     uint env_width, env_height; /* the environment map's texels (-D MCRT_ENVIRONMENT_MAP builds;
                                    sky.w is then the probability of choosing it) */
     float env_cos_rot, env_sin_rot; /* its turn about +Y (--env-rotate) */
-    uint pad0, pad1;
+    uint punctual_count;   /* punctual lights (RENDER_ARG_PUNCTUAL), chosen after the
+                              light_count area lights (-D MCRT_PUNCTUAL builds); 0 otherwise */
+    uint pad1;
 } RenderParams;
 
 /* What reduce_chunks writes for one run of samples: the samples of one pixel, one chunk and one
@@ -392,6 +413,8 @@ enum RenderArgument {
                                    texel, row 0 at the zenith) followed by its texel CDF
                                    (env_width·env_height + 1 entries) (-D MCRT_ENVIRONMENT_MAP
                                    builds; a placeholder otherwise) */
+    RENDER_ARG_PUNCTUAL,        /* global const PunctualGpu*: the punctual lights (-D
+                                   MCRT_PUNCTUAL builds; a placeholder otherwise) */
     RENDER_ARG_CAMERA,          /* global const CameraGpu* */
     RENDER_ARG_SAMPLES,         /* global uint4*: out, one per work-item (the radiance's bits,
                                    the packed PathRecord) */
@@ -435,6 +458,10 @@ enum RenderArgument {
     FIELD(TextureHeader, texels, 12)                                                            \
     TYPE(TriangleSurface, 144, 16) FIELD(TriangleSurface, uv, 0)                                \
     FIELD(TriangleSurface, normal, 48) FIELD(TriangleSurface, tangent, 96)                      \
+    TYPE(PunctualGpu, 64, 16) FIELD(PunctualGpu, position, 0)                                   \
+    FIELD(PunctualGpu, direction, 16) FIELD(PunctualGpu, intensity, 32)                         \
+    FIELD(PunctualGpu, spot_scale, 48) FIELD(PunctualGpu, spot_offset, 52)                      \
+    FIELD(PunctualGpu, type, 56)                                                                \
     TYPE(LightTreePath, 8, 4) FIELD(LightTreePath, bits, 0) FIELD(LightTreePath, length, 4)     \
     TYPE(AliasEntry, 16, 4) FIELD(AliasEntry, threshold, 0) FIELD(AliasEntry, alias, 4)         \
     FIELD(AliasEntry, pmf, 8)                                                                   \
@@ -455,6 +482,7 @@ enum RenderArgument {
     FIELD(RenderParams, rr_depth, 64) FIELD(RenderParams, light_tree_nodes, 68)                 \
     FIELD(RenderParams, env_width, 72) FIELD(RenderParams, env_height, 76)                      \
     FIELD(RenderParams, env_cos_rot, 80) FIELD(RenderParams, env_sin_rot, 84)                   \
+    FIELD(RenderParams, punctual_count, 88)                                                     \
     TYPE(ChunkSums, 64, 16) FIELD(ChunkSums, shift, 0) FIELD(ChunkSums, sum, 16)                \
     FIELD(ChunkSums, sum_sq, 32) FIELD(ChunkSums, exponent, 48)
 

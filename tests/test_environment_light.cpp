@@ -342,3 +342,38 @@ TEST_CASE(
           std::string::npos);
     CHECK_FALSE(std::filesystem::exists(dir / "a.exr"));
 }
+
+TEST_CASE("an environment map beside punctual lights alone: both are chosen",
+          "[environment][punctual][cli]") {
+    // A scene lit only by a KHR_lights_punctual light, with a dim uniform map: the map's share
+    // of the choice is by power against the punctual light's, never all of it (which would
+    // leave the light unseen). The image is the light's, plus the map's albedo × 1e-4.
+    TempDir dir;
+    const std::string scene = scene_path("punctual/point-light.gltf");
+    const std::string map = write_map(dir, "dim.exr", 8, 4, [](int, int, int) { return 1e-4f; });
+    auto render_mean = [&](const std::vector<std::string>& extra, const std::string& name,
+                           double& variance) {
+        std::vector<std::string> args = {"render",      scene,  "--width", "16", "--height",
+                                         "16",          "--spp", "64",     "--estimator",
+                                         "light-area",  "--quiet", "--out", dir / name};
+        args.insert(args.end(), extra.begin(), extra.end());
+        const ProcessResult r = run_process(MCRT_EXE, args, dir.path());
+        INFO(r.err);
+        REQUIRE(r.exit_code == 0);
+        const Image image = read_exr(dir / name);
+        const double n = double(image.rgb.size());
+        double sum = 0.0;
+        variance = 0.0;
+        for (size_t k = 0; k < image.rgb.size(); ++k) {
+            sum += image.rgb[k];
+            variance += image.variance[k] / (n * n);
+        }
+        return sum / n;
+    };
+    double var_light = 0.0, var_both = 0.0;
+    const double light = render_mean({}, "light.exr", var_light);
+    const double both = render_mean({"--env", map}, "both.exr", var_both);
+    INFO("light alone " << light << ", with the map " << both);
+    REQUIRE(light > 1e-2);  // the light is seen: the comparison can fail
+    CHECK(std::abs(both - light) <= 4.5 * std::sqrt(var_light + var_both) + 1e-4);
+}

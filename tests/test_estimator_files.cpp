@@ -63,6 +63,35 @@ TEST_CASE("examples/estimators/light_area.cl renders light-area's image bit for 
         }
 }
 
+TEST_CASE("an estimator file sees punctual lights through the light strategies: light-area's image",
+          "[estimator-file][cli][punctual]") {
+    // sample_light_area chooses point, spot and directional lights beside the area light, so
+    // the example draws them as the built-in does, on every selection.
+    TempDir tmp("mcrt-estimator-file");
+    const std::string scene = std::string(MCRT_SCENES) + "/punctual/punctual-lights.gltf";
+    for (const char* select : {"power", "tree"}) {
+        std::vector<std::string> common = {scene,   "--width",        "40",   "--height", "32",
+                                           "--spp", "16",             "--seed", "5",
+                                           "--light-select", select,  "--max-depth", "2",
+                                           "--quiet"};
+        std::vector<std::string> builtin = {"render", "--out", tmp / "builtin.exr",
+                                            "--estimator", "light-area"};
+        std::vector<std::string> file = {"render", "--out", tmp / "file.exr", "--estimator-file",
+                                         kLightArea};
+        builtin.insert(builtin.end(), common.begin(), common.end());
+        file.insert(file.end(), common.begin(), common.end());
+        INFO(select);
+        REQUIRE(run_mcrt(tmp, builtin).exit_code == 0);
+        REQUIRE(run_mcrt(tmp, file).exit_code == 0);
+        Image a = read_exr(tmp / "builtin.exr"), b = read_exr(tmp / "file.exr");
+        double sum = 0;
+        for (float v : a.rgb) sum += v;
+        CHECK(sum > 0);
+        CHECK(same_bits(a.rgb, b.rgb));
+        CHECK(same_bits(a.variance, b.variance));
+    }
+}
+
 TEST_CASE("examples/estimators/bsdf_directions.cl renders bsdf's image bit for bit on glossy and Lambertian surfaces, and under the sky light",
           "[estimator-file][cli][materials]") {
     TempDir tmp("mcrt-estimator-file");

@@ -283,6 +283,27 @@ TEST_CASE("mpirun -n 2 renders the image of one process under an environment map
     CHECK(same_bits(a.variance, b.variance));
 }
 
+TEST_CASE("mpirun -n 2 renders punctual lights as one process does, bit for bit",
+          "[mpi][cli][punctual]") {
+    // Every rank reads the KHR_lights_punctual lights from the bundle and builds the same
+    // light tree over them and the area light.
+    TempDir dir;
+    const std::string scene = std::string(MCRT_SCENES) + "/punctual/punctual-lights.gltf";
+    auto args = [&](const std::string& out) {
+        return std::vector<std::string>{"render", scene, "--width", "40", "--height", "32",
+                                        "--spp", "32", "--estimator", "mis", "--light-select",
+                                        "tree", "--max-depth", "3", "--quiet", "--out", out};
+    };
+    ProcessResult one = run_process(MCRT_EXE, args(dir / "one.exr"), dir.path());
+    REQUIRE(one.exit_code == 0);
+    ProcessResult two = run_mpi(2, args(dir / "two.exr"), dir);
+    INFO("stderr: " << two.err);
+    REQUIRE(two.exit_code == 0);
+    Image a = read_exr(dir / "one.exr"), b = read_exr(dir / "two.exr");
+    CHECK(same_bits(a.rgb, b.rgb));
+    CHECK(same_bits(a.variance, b.variance));
+}
+
 TEST_CASE("two ranks of two devices each render the image of one process", "[mpi][cli]") {
     mpirun();
     TempDir dir;

@@ -54,6 +54,7 @@ void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene,
     CL_CHECK(render.setArg(gpu::RENDER_ARG_SURFACES, scene.surfaces));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_TEXTURES, scene.textures));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_ENVIRONMENT, environment));
+    CL_CHECK(render.setArg(gpu::RENDER_ARG_PUNCTUAL, scene.punctual));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_CAMERA, scene.camera));
     CL_CHECK(render.setArg(gpu::RENDER_ARG_SAMPLES, samples));
 }
@@ -186,7 +187,7 @@ void DeviceWorker::start(const WorkItem& item) {
     params.sky = {settings_.sky.r, settings_.sky.g, settings_.sky.b,
                   environment_.get() && environment_width_ > 0
                       ? environment_pmf_
-                      : sky_light_pmf(settings_, buffers_->light_count)};
+                      : sky_light_pmf(settings_, buffers_->light_count + buffers_->punctual_count)};
     params.env_width = environment_width_;
     params.env_height = environment_height_;
     params.env_cos_rot = environment_cos_;
@@ -198,6 +199,7 @@ void DeviceWorker::start(const WorkItem& item) {
     params.spp = settings_.spp;
     params.light_count = buffers_->light_count;
     params.light_tree_nodes = buffers_->light_tree_nodes;
+    params.punctual_count = buffers_->punctual_count;
     params.pixel_begin = item.pixel_begin;
     params.pixel_end = item.pixel_end;
     params.sample_begin = sample_begin;

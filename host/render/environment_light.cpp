@@ -78,7 +78,9 @@ std::shared_ptr<const EnvironmentLight> load_environment_light(const std::string
 uint32_t environment_pmf_steps(const EnvironmentLight& env, const GpuSceneData& scene,
                                LightSelection selection) {
     constexpr double kSteps = 16777216.0;  // the 2^-24 grid of the selection sample
-    const size_t n = scene.lights.size();
+    // Every light the selection chooses among: the area lights, then the punctual ones
+    // (light_powers holds both), so that a scene lit by punctual lights alone still has them.
+    const size_t n = scene.lights.size() + scene.punctual.size();
     double total = 0.0;
     for (double p : scene.light_powers) total += p;
     if (n == 0 || !(total > 0.0)) return uint32_t(kSteps);

@@ -201,6 +201,48 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
         powers.push_back(e.power);
         light_of_triangle[e.triangle] = uint32_t(data.lights.size());
     }
+    // Punctual lights after the area lights, by their power (punctual_power: the disk of the
+    // scene's bounding sphere for a directional light), in the tree with pbrt-v4's bounds.
+    const glm::dvec3 scene_lo(scene.bounds_min()), scene_hi(scene.bounds_max());
+    const double radius =
+        scene.triangle_count() > 0 ? 0.5 * glm::length(scene_hi - scene_lo) : 0.0;
+    constexpr double kPi = 3.14159265358979323846;
+    for (const PunctualLight& l : scene.punctual_lights) {
+        gpu::PunctualGpu g{};
+        g.position = to_float4(l.position);
+        g.direction = to_float4(l.direction);
+        g.intensity = to_float4(l.intensity);
+        g.spot_scale = l.spot_scale;
+        g.spot_offset = l.spot_offset;
+        LightTreeItem item;
+        const double y =
+            0.2126 * l.intensity.r + 0.7152 * l.intensity.g + 0.0722 * l.intensity.b;
+        item.lo = item.hi = glm::dvec3(l.position);
+        item.axis = glm::dvec3(l.direction);
+        item.phi = 4.0 * kPi * y;
+        switch (l.type) {
+            case PunctualType::Point: g.type = PUNCTUAL_POINT; break;
+            case PunctualType::Spot:
+                g.type = PUNCTUAL_SPOT;
+                // θ_o = inner, θ_e = outer − inner: the falloff is positive for θ < outer, where
+                // the importance is too (θ_e at least 10⁻³ rad, so that it is when inner = outer).
+                item.cos_o = l.cos_inner;
+                item.cos_e = std::cos(std::max(
+                    std::acos(double(l.cos_outer)) - std::acos(double(l.cos_inner)), 1e-3));
+                break;
+            case PunctualType::Directional:
+                // The whole scene's box: inside its sphere the importance is 4πr²E / r² = 4πE,
+                // as a point light's is 4π × the irradiance it gives.
+                g.type = PUNCTUAL_DIRECTIONAL;
+                item.lo = scene_lo;
+                item.hi = scene_hi;
+                item.phi = 4.0 * kPi * radius * radius * y;
+                break;
+        }
+        data.punctual.push_back(g);
+        data.punctual_tree_items.push_back(item);
+        powers.push_back(punctual_power(l, radius));
+    }
     data.light_powers = std::move(powers);
     build_light_selection(data, selection);
     // Shading's view of each packet lane (unused lanes stay zero: no ray hits them).
@@ -258,7 +300,9 @@ void build_light_selection(GpuSceneData& data, LightSelection selection) {
         case LightSelection::Uniform: break;
         case LightSelection::Power: data.light_cdf = build_cdf(powers); break;
         case LightSelection::Alias: data.light_alias = build_alias_table(powers); break;
-        case LightSelection::Tree: data.light_tree = build_light_tree(data.lights, powers); break;
+        case LightSelection::Tree:
+            data.light_tree = build_light_tree(data.lights, powers, 0, data.punctual_tree_items);
+            break;
     }
 }
 
@@ -308,8 +352,10 @@ GpuSceneBuffers::GpuSceneBuffers(const DeviceContext& device, const GpuSceneData
                              "light selection data");
     surfaces = upload(device, data.surfaces, bytes, "texture coordinates and tangents");
     textures = upload(device, data.textures, bytes, "textures");
+    punctual = upload(device, data.punctual, bytes, "punctual lights");
     camera = upload(device, std::vector<gpu::CameraGpu>{data.camera}, bytes, "camera");
     light_count = cl_uint(data.lights.size());
+    punctual_count = cl_uint(data.punctual.size());
 }
 
 cl::Buffer upload_light_selection(const DeviceContext& device, const GpuSceneData& data,

@@ -22,11 +22,16 @@ struct GpuSceneData {
     std::vector<gpu::TriangleInfo> triangle_info;  // per packet lane: 4 per packet
     std::vector<gpu::Material> materials;
     std::vector<gpu::Light> lights;
+    // KHR_lights_punctual lights (RENDER_ARG_PUNCTUAL): the selection's lights after `lights`;
+    // a scene with any gets kernels that draw them (-D MCRT_PUNCTUAL), one without none.
+    std::vector<gpu::PunctualGpu> punctual;
+    std::vector<LightTreeItem> punctual_tree_items;  // their bounds in the light tree
     // The light selection's own data, only that of `light_selection` built: power's CDF
     // (lights + 1 entries, PBRT 3rd ed. 13.3.1), alias's table of the same distribution, or the
     // tree (render/light_tree.h); uniform has none.
     LightSelection light_selection = LightSelection::Power;
-    std::vector<double> light_powers;  // one per light: what every selection is built from
+    std::vector<double> light_powers;  // one per light, then per punctual light: what every
+                                       // selection is built from
     std::vector<float> light_cdf;
     std::vector<gpu::AliasEntry> light_alias;
     LightTree light_tree;
@@ -69,8 +74,9 @@ std::vector<uint32_t> light_selection_words(const GpuSceneData& data, uint32_t* 
 struct GpuSceneBuffers {
     GpuSceneBuffers(const DeviceContext& device, const GpuSceneData& data);
     cl::Buffer nodes, packets, triangle_info, materials, lights, light_selection, surfaces,
-        textures, camera;
-    cl_uint light_count = 0;
+        textures, punctual, camera;
+    cl_uint light_count = 0;     // area lights
+    cl_uint punctual_count = 0;  // punctual lights, chosen after them
     cl_uint light_tree_nodes = 0;
     size_t bytes = 0;
 };

@@ -643,10 +643,19 @@ struct Collapser {
 }  // namespace
 
 LightTree build_light_tree(const std::vector<gpu::Light>& lights,
-                           const std::vector<double>& powers, int threads) {
+                           const std::vector<double>& powers, int threads,
+                           const std::vector<LightTreeItem>& more) {
     LightTree tree;
-    tree.paths.assign(lights.size(), gpu::LightTreePath{0u, 0u});
+    const size_t total = lights.size() + more.size();
+    tree.paths.assign(total, gpu::LightTreePath{0u, 0u});
+    // A punctual light's box, for its centre: its corners as the triangle's three vertices.
     auto vertices = [&](size_t i, glm::dvec3* p) {
+        if (i >= lights.size()) {
+            const LightTreeItem& item = more[i - lights.size()];
+            p[0] = item.lo;
+            p[1] = p[2] = item.hi;
+            return;
+        }
         const gpu::Light& l = lights[i];
         p[0] = {l.p0.x, l.p0.y, l.p0.z};
         p[1] = {l.p1.x, l.p1.y, l.p1.z};
@@ -656,10 +665,10 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
     // lights then lie together in memory, which the splits' passes over them read in far fewer
     // cache lines.
     if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
-    std::vector<glm::dvec3> centre(lights.size());
+    std::vector<glm::dvec3> centre(total);
     std::mutex box_mutex;
     Bounds box;  // of the centres (min and max: the same in any order)
-    parallel_for(threads, lights.size(), [&](size_t begin, size_t end) {
+    parallel_for(threads, total, [&](size_t begin, size_t end) {
         Bounds part;
         for (size_t i = begin; i < end; ++i) {
             if (!(powers[i] > 0.0)) continue;
@@ -675,8 +684,8 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
         box.hi = glm::max(box.hi, part.hi);
     });
     std::vector<uint64_t> keys;
-    keys.reserve(lights.size());
-    for (size_t i = 0; i < lights.size(); ++i)
+    keys.reserve(total);
+    for (size_t i = 0; i < total; ++i)
         if (powers[i] > 0.0) keys.push_back(i);
     if (keys.empty()) return tree;
     const glm::dvec3 extent = glm::max(box.hi - box.lo, glm::dvec3(1e-300));
@@ -713,6 +722,20 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
     parallel_for(threads, count, [&](size_t begin, size_t end) {
         for (size_t k = begin; k < end; ++k) {
             const uint32_t i = uint32_t(keys[k]);
+            centroid[k] = centre[i];
+            light_of[k] = i;
+            order[k] = uint32_t(k);
+            if (i >= lights.size()) {
+                const LightTreeItem& item = more[i - lights.size()];
+                Bounds& b = *new (&items[k]) Bounds();
+                b.lo = item.lo;
+                b.hi = item.hi;
+                b.phi = item.phi;
+                b.normals = item.cos_o <= -1.0 ? whole_sphere(item.axis)
+                                               : Cone{item.axis, item.cos_o, false};
+                b.cos_e = item.cos_e;
+                continue;
+            }
             glm::dvec3 p[3];
             vertices(i, p);
             const glm::dvec3 normal = glm::cross(p[1] - p[0], p[2] - p[0]);
@@ -727,9 +750,6 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
             b.normals = length > 0.0 ? Cone{normal / length, 1.0, false} : whole_sphere({0, 0, 1});
             b.cos_e = 0.0;
             b.two_sided = (lights[i].flags & MATERIAL_DOUBLE_SIDED) != 0u;
-            centroid[k] = centre[i];
-            light_of[k] = i;
-            order[k] = uint32_t(k);
         }
     });
     const size_t binary_count = 2 * order.size() - 1;

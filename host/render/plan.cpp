@@ -93,7 +93,8 @@ RenderPlan finish_render_plan(RenderPlan plan, const GpuSceneData& scene) {
     const RenderSettings& s = plan.settings;
     plan.program_options = variant_program_options(plan.variants, scene.microfacet, scene.textured,
                                                    scene.transmission, scene.single_sided,
-                                                   plan.environment != nullptr);
+                                                   plan.environment != nullptr,
+                                                   !scene.punctual.empty());
     plan.fixed_batch =
         s.batch > 0 ? uint64_t(s.width) * uint64_t(s.height) *
                           batch_samples_per_pixel(s.batch, s.width, s.height, s.spp)
@@ -110,6 +111,25 @@ RenderPlan make_render_plan(const RenderSettings& settings, const GpuSceneData& 
     }
     plan_environment(plan, scene, SceneSource{});
     return finish_render_plan(std::move(plan), scene);
+}
+
+void warn_unseen_lights(const std::string& scene_path, const RenderPlan& plan,
+                        const GpuSceneData& scene, const WarningSink& warn) {
+    if (!warn) return;
+    const RenderVariants& v = plan.variants;
+    const RenderSettings& s = plan.settings;
+    const size_t punctual = scene.punctual.size();
+    const bool sees_punctual = v.uses(kUsesLightSelection);
+    // One warning at most: the punctual lights' where the estimator cannot see them.
+    if (v.uses(kUsesLights) && !s.sky_light && scene.lights.empty() && punctual == 0)
+        warn(scene_path + ": no emissive triangles: direct lighting is black" +
+             (v.uses(kUsesSkyLight) ? " (--sky R,G,B adds a sky light)" : ""));
+    if (punctual > 0 && !sees_punctual)
+        warn(scene_path + ": estimator " + v.estimator.name + " cannot see the scene's " +
+             std::to_string(punctual) + " KHR_lights_punctual light" +
+             (punctual == 1 ? "" : "s") +
+             " (delta lights: no direction it draws finds one); light-area, light-solid-angle "
+             "and mis sample them");
 }
 
 Camera choose_camera(const Scene& scene, const CameraChoice& choice) {
@@ -165,9 +185,7 @@ PlannedRender plan_render(const RenderRequest& request, const SceneSource& sourc
                                      v.light_select->id);
     }
     if (warn && scene.triangle_count() == 0) warn(request.scene + ": the scene has no triangles");
-    if (warn && v.uses(kUsesLights) && !s.sky_light && r.scene.gpu.lights.empty())
-        warn(request.scene + ": no emissive triangles: direct lighting is black" +
-             (v.uses(kUsesSkyLight) ? " (--sky R,G,B adds a sky light)" : ""));
+    warn_unseen_lights(request.scene, r.plan, r.scene.gpu, warn);
     plan_environment(r.plan, r.scene.gpu, source);
     r.plan = finish_render_plan(std::move(r.plan), r.scene.gpu);
     return r;

@@ -98,6 +98,12 @@ RenderPlan make_render_plan(const RenderSettings& settings, const GpuSceneData& 
 PlannedRender plan_render(const RenderRequest& request, const SceneSource& source,
                           const WarningSink& warn);
 
+// Warns, through `warn`, of lights the render cannot show: none at all for an estimator that
+// needs lights, or punctual lights that the estimator cannot see (delta lights: no direction
+// drawn on the hemisphere finds one), naming the estimator and how many.
+void warn_unseen_lights(const std::string& scene_path, const RenderPlan& plan,
+                        const GpuSceneData& scene, const WarningSink& warn);
+
 // The camera `choice` names in `scene`; throws SettingError for an index it does not have.
 Camera choose_camera(const Scene& scene, const CameraChoice& choice);
 

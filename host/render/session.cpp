@@ -53,16 +53,13 @@ RenderPlan plan_session_render(SessionScene& scene, const RenderRequest& request
     if (plan.settings.materials != scene.materials)
         throw SettingError("materials", plan.settings.materials + ": the scene was loaded with " +
                                             scene.materials);
-    const RenderVariants& v = plan.variants;
     const RenderSettings& s = plan.settings;
     PreparedScene& prepared = scene.prepared;
     prepared.camera = choose_camera(prepared.scene, request.camera);
     prepared.gpu.camera = make_gpu_camera(prepared.camera, s.width, s.height);
     if (warn && prepared.scene.triangle_count() == 0)
         warn(scene.path + ": the scene has no triangles");
-    if (warn && v.uses(kUsesLights) && !s.sky_light && prepared.gpu.lights.empty())
-        warn(scene.path + ": no emissive triangles: direct lighting is black" +
-             (v.uses(kUsesSkyLight) ? " (--sky R,G,B adds a sky light)" : ""));
+    warn_unseen_lights(scene.path, plan, prepared.gpu, warn);
     plan_environment(plan, prepared.gpu, source);
     return finish_render_plan(std::move(plan), prepared.gpu);
 }

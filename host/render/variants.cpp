@@ -128,7 +128,8 @@ RenderVariants resolve_variants(const RenderSettings& settings) {
 }
 
 std::string variant_program_options(const RenderVariants& v, bool microfacet, bool textured,
-                                    bool transmission, bool single_sided, bool environment_map) {
+                                    bool transmission, bool single_sided, bool environment_map,
+                                    bool punctual) {
     std::string options = std::string("-cl-std=CL1.2 -D MCRT_ESTIMATE=") + v.estimator.function;
     if (v.ambient()) options += " -D MCRT_AMBIENT_ESTIMATOR";
     options += std::string(" -D ") + v.light_select->macro;
@@ -148,6 +149,9 @@ std::string variant_program_options(const RenderVariants& v, bool microfacet, bo
     if (single_sided) options += " -D MCRT_SINGLE_SIDED";
     // Texel lookups and the map's 2D distribution only for a render with --env.
     if (environment_map) options += " -D MCRT_ENVIRONMENT_MAP";
+    // Punctual lights only for a scene that has them, and only for estimators that can sample
+    // them (a light selection's strategies); the others cannot see them (DESIGN.md).
+    if (punctual && v.uses(kUsesLightSelection)) options += " -D MCRT_PUNCTUAL";
     return options;
 }
 

@@ -121,10 +121,12 @@ RenderVariants resolve_variants(const RenderSettings& settings);
 // surface that is not Lambertian; `textured`: a material with a texture or alpha test
 // (-D MCRT_TEXTURES); `transmission`: a transmissive material (-D MCRT_TRANSMISSION, with the
 // glTF model only); `single_sided`: a triangle whose back face is culled (-D MCRT_SINGLE_SIDED);
-// `environment_map`: a render with --env (-D MCRT_ENVIRONMENT_MAP).
+// `environment_map`: a render with --env (-D MCRT_ENVIRONMENT_MAP); `punctual`: KHR_lights_punctual
+// lights (-D MCRT_PUNCTUAL).
 std::string variant_program_options(const RenderVariants& variants, bool microfacet,
                                     bool textured, bool transmission = false,
-                                    bool single_sided = false, bool environment_map = false);
+                                    bool single_sided = false, bool environment_map = false,
+                                    bool punctual = false);
 
 // The rows' names, in table order (CLI11's IsMember, --help, the tests).
 template <typename Row>

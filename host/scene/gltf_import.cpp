@@ -76,11 +76,6 @@ Scene import_default_scene(const tinygltf::Model& model, const std::string& path
         }
     });
     geometry.finish();
-    if (!scene.punctual_lights.empty()) {
-        diag.warn_once("lights", std::to_string(scene.punctual_lights.size()) +
-                                     " KHR_lights_punctual light(s) read; the renderer does not "
-                                     "draw punctual lights yet");
-    }
     gltf::warn_open_volumes(scene, diag);
     for (const tinygltf::Camera& camera : model.cameras) scene.gltf_camera_types.push_back(camera.type);
     // The images the used materials' texture slots name, once the walk has found them all.
