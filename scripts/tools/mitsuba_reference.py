@@ -29,7 +29,11 @@ Mitsuba 3 scene and renders it:
              (roughness 0) or `roughdielectric` with the material's ior, the transmission tinted
              by the base colour, blended with a Lambertian base where transmissionFactor < 1,
              an absorbing volume an interior `homogeneous` medium under `volpath`; thin-walled
-             glass has no Mitsuba equivalent and is refused (MaterialConversion.glass_bsdf);
+             glass has no Mitsuba equivalent and is refused (MaterialConversion.glass_bsdf).
+             Every opaque surface stays two-sided: mcrt culls a single-sided surface seen from
+             behind (docs/DESIGN.md), but Mitsuba's `twosided` cannot hold a `null` back, so
+             where a ray meets such a back face the two renderers differ (an emitter's back is
+             black in Mitsuba, absent in mcrt);
   textures   (glTF 2.0 "Texture Data", "Metallic-Roughness Material", "Additional Textures")
              each slot becomes a `bitmap` with raw = true holding the values mcrt computes
              before filtering: baseColor and emissive texels sRGB-decoded (IEC 61966-2-1) and
@@ -62,7 +66,9 @@ Mitsuba 3 scene and renders it:
              emissiveTexture). Mitsuba's area emitters emit on the front side of the mesh
              normal, which for a PLY mesh is cross(p1 − p0, p2 − p0): glTF's
              counter-clockwise front, as mcrt. A `doubleSided`
-             emitter gets a second, flipped copy 1e-6·diag behind it;
+             emitter gets a second, flipped copy 1e-6·diag behind it; KHR_lights_punctual
+             lights are `point`, `spot` (its falloff between the cones approximate: a
+             warning) and `directional` emitters; --env is an `envmap` (environment_emitter);
   camera     the first perspective camera node (--camera K: the first node of glTF camera K,
              as mcrt) or the bench camera of DESIGN.md, `perspective` with
              fov_axis y and fov = yfov; the glTF camera looks down −Z, Mitsuba's down +Z, so the
@@ -279,6 +285,25 @@ class Gltf:
                     # bitangent = w · cross(N, T) (glTF 2.0 "Meshes"): a mirror flips w
                     corners.tangent_w = (t[:, 3] * (-1.0 if mirrored else 1.0))[tri]
                 out.setdefault(prim.get("material", -1), []).append(corners)
+        return out
+
+    def punctual_lights(self):
+        """KHR_lights_punctual as mcrt reads them (docs/DESIGN.md): (type, colour × intensity,
+        world position, world direction the light points along (the node's −Z), inner and outer
+        cone angles) of every node of the default scene that carries one."""
+        lights = self.doc.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
+        out = []
+        for node, world in self.walk():
+            index = node.get("extensions", {}).get("KHR_lights_punctual", {}).get("light")
+            if index is None:
+                continue
+            light = lights[index]
+            value = [c * light.get("intensity", 1.0) for c in light.get("color", [1, 1, 1])]
+            direction = -world[:3, 2]
+            direction = direction / np.linalg.norm(direction)
+            spot = light.get("spot", {})
+            out.append((light["type"], value, world[:3, 3].copy(), direction,
+                        spot.get("innerConeAngle", 0.0), spot.get("outerConeAngle", math.pi / 4)))
         return out
 
     def triangles(self):
@@ -768,8 +793,52 @@ def integrator(max_depth, rr_depth, emitter_samples=1, bsdf_samples=1, null_surf
             "hide_emitters": False}
 
 
+def environment_emitter(mi, path, scale, rotate):
+    """mcrt's --env FILE --env-scale S --env-rotate DEG as Mitsuba's `envmap`: the same
+    latitude-longitude convention (+Y up, docs/DESIGN.md), turned about +Y by DEG. mcrt reads a
+    texel's radiance as constant over it (nearest), Mitsuba's envmap interpolates bilinearly:
+    the map is handed over with each texel repeated k × k times (k up to 8, the width up to
+    8192), so the two differ only within half a repeated texel of each texel's edge."""
+    bitmap = mi.Bitmap(str(path)).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32,
+                                          srgb_gamma=False)
+    texels = np.array(bitmap, dtype=np.float32)[..., :3]
+    k = max(1, min(8, 8192 // max(1, texels.shape[1])))
+    texels = np.repeat(np.repeat(texels, k, axis=0), k, axis=1)
+    return {"type": "envmap", "bitmap": mi.Bitmap(texels), "scale": float(scale),
+            "to_world": mi.ScalarTransform4f().rotate(axis=[0, 1, 0], angle=float(rotate))}
+
+
+def punctual_emitters(mi, gltf):
+    """KHR_lights_punctual as Mitsuba's `point`, `spot` and `directional` emitters (radiant
+    intensity, and irradiance for directional, as mcrt reads them). A spot's falloff differs
+    in the ring between its cones: glTF's (and mcrt's) is clamp((cos θ − cos outer) /
+    (cos inner − cos outer), 0, 1)², Mitsuba's linear in the angle; they agree inside the inner
+    cone and outside the outer one (a warning says so)."""
+    emitters = {}
+    for k, (kind, value, position, direction, inner, outer) in enumerate(gltf.punctual_lights()):
+        rgb = {"type": "rgb", "value": list(value)}
+        if kind == "point":
+            emitters["punctual%d" % k] = {"type": "point", "position": position.tolist(),
+                                          "intensity": rgb}
+        elif kind == "directional":
+            emitters["punctual%d" % k] = {"type": "directional", "direction": direction.tolist(),
+                                          "irradiance": rgb}
+        elif kind == "spot":
+            warn("spot light %d: Mitsuba's falloff between the cones (%.1f° to %.1f°) is linear "
+                 "in the angle, glTF's a squared ramp in cos θ: approximate there"
+                 % (k, math.degrees(inner), math.degrees(outer)))
+            up = [0.0, 1.0, 0.0] if abs(direction[1]) < 0.9 else [1.0, 0.0, 0.0]
+            emitters["punctual%d" % k] = {
+                "type": "spot", "intensity": rgb,
+                "cutoff_angle": math.degrees(outer), "beam_width": math.degrees(inner),
+                "to_world": mi.ScalarTransform4f().look_at(
+                    origin=position.tolist(), target=(position + direction).tolist(), up=up)}
+    return emitters
+
+
 def mitsuba_scene(mi, gltf, width, height, spp, scratch, max_depth=1, rr_depth=5, sky=None,
-                  materials="lambert", integrator_desc=None, camera=None, normal_maps=True):
+                  materials="lambert", integrator_desc=None, camera=None, normal_maps=True,
+                  environment=None):
     """(scene dict, emitter count) of a glTF; PLY meshes are written to `scratch`. The
     integrator is integrator_desc when given, else integrator(max_depth, rr_depth). `camera`:
     the index of the scene's camera, or (eye, target, up, vertical fov in degrees), mcrt's
@@ -806,6 +875,12 @@ def mitsuba_scene(mi, gltf, width, height, spp, scratch, max_depth=1, rr_depth=5
     if sky:  # mcrt's --sky with a direct or path estimator: a uniform light at infinity
         scene["sky"] = {"type": "constant", "radiance": {"type": "rgb", "value": list(sky)}}
         emitters += 1
+    if environment:  # mcrt's --env, --env-scale, --env-rotate
+        scene["environment"] = environment_emitter(mi, *environment)
+        emitters += 1
+    punctual = punctual_emitters(mi, gltf)
+    scene.update(punctual)
+    emitters += len(punctual)
     textures = Textures(mi, gltf, scratch)
     for k, material in enumerate(sorted(primitives)):
         conv = conversions[material]
@@ -871,14 +946,14 @@ def import_mitsuba(variant):
 
 def load_scene(mi, path, width, height, spp, max_depth=1, rr_depth=5, sky=None,
                materials="lambert", integrator_desc=None, camera=None, normal_maps=True,
-               info=None):
+               info=None, environment=None):
     """(loaded Mitsuba scene, emitter count, seconds of mi.load_dict) of the glTF at `path`
     (mitsuba_scene's arguments); `info`, a dict, receives the integrator's description."""
     gltf = Gltf(path)
     with tempfile.TemporaryDirectory(prefix="mcrt-mitsuba-") as scratch:
         desc, emitters = mitsuba_scene(mi, gltf, width, height, spp, scratch, max_depth,
                                        rr_depth, sky, materials, integrator_desc, camera,
-                                       normal_maps)
+                                       normal_maps, environment)
         if info is not None:
             info["integrator"] = ", ".join("%s=%s" % kv for kv in desc["integrator"].items())
         start = time.monotonic()
@@ -895,7 +970,9 @@ def render(args):
                                                args.max_depth, args.rr_depth, args.sky,
                                                args.materials, camera=args.camera,
                                                normal_maps=not args.no_normal_maps,
-                                               info=described)
+                                               info=described,
+                                               environment=(args.env, args.env_scale,
+                                                            args.env_rotate) if args.env else None)
     sum1 = np.zeros((args.height, args.width, 3))
     sum2 = np.zeros_like(sum1)
     seconds = []
@@ -1088,6 +1165,10 @@ def main():
     p.add_argument("--rr-depth", type=int, default=5, help="with --max-depth > 1: `path`'s rr_depth")
     p.add_argument("--sky", type=lambda t: [float(x) for x in (t.split(",") * 3)[:3]],
                    help="R,G,B (or one value): a `constant` emitter, as mcrt's --sky light")
+    p.add_argument("--env", help="an environment map (.exr, .hdr), as mcrt's --env: `envmap`")
+    p.add_argument("--env-scale", type=float, default=1.0, help="as mcrt's --env-scale")
+    p.add_argument("--env-rotate", type=float, default=0.0,
+                   help="degrees about +Y, as mcrt's --env-rotate")
     p.add_argument("--compare", help="an mcrt EXR of the same size to compare with")
     p.add_argument("--diff-png", help="with --compare: write the difference image here")
     p.add_argument("--equal-time", metavar="REF.exr",
@@ -1099,6 +1180,8 @@ def main():
     args = p.parse_args()
     if (args.look_from is None) != (args.look_at is None):
         p.error("--look-from and --look-at go together")
+    if args.env and args.sky:
+        p.error("--env and --sky exclude each other, as in mcrt")
     if args.look_from is not None:
         args.camera = (args.look_from, args.look_at, args.up, args.fov)
     use_mitsuba_venv()
