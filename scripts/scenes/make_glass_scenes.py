@@ -84,7 +84,9 @@ def glass_window():
     of thin-walled glass in it, and a light outside at x = −1.5 facing the window."""
     g = StressScene("glass-window")
     floor(g, 3.0, (0.7, 0.7, 0.7))
-    wall = g.lambertian("wall", (0.6, 0.6, 0.6))
+    # Double-sided: a single-sided wall facing the room would be absent seen from outside, and
+    # light would pass through it from the outside in.
+    wall = g.lambertian("wall", (0.6, 0.6, 0.6), double_sided=True)
     Y = (0.0, 1.0, 0.0)
     # Four pieces around the window, each a quad in the plane x = 0 facing +x (Y × Z = +x).
     for center, h, w in [((0.0, 0.25, 0.0), 0.5, 6.0), ((0.0, 2.25, 0.0), 1.5, 6.0),

@@ -70,10 +70,13 @@ class StressScene(Gltf):
 
     LAMBERTIAN = {"KHR_materials_specular": {"specularFactor": 0.0}}
 
-    def lambertian(self, name, albedo):
-        return self.material(name=name, pbrMetallicRoughness={
+    def lambertian(self, name, albedo, double_sided=False):
+        fields = {"name": name, "pbrMetallicRoughness": {
             "baseColorFactor": [*albedo, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0},
-            extensions=dict(self.LAMBERTIAN))
+            "extensions": dict(self.LAMBERTIAN)}
+        if double_sided:  # seen from behind too (glTF 2.0 "Double Sided"; else culled there)
+            fields["doubleSided"] = True
+        return self.material(**fields)
 
     def emitter(self, name, Le, albedo=(0.0, 0.0, 0.0), double_sided=False):
         """Le = emissiveFactor × emissiveStrength, the factor's largest component 1."""
