@@ -165,7 +165,12 @@ TEST_CASE("a wall's shadow under a map of bright columns: the sampled and the lo
     settings.env_rotate = 50.0f;
     settings.spp = 128;
     Scene scene = floor_scene(glm::dvec3(0.5), false);
-    add_quad(scene, {0.3f, 0, -3}, {0.3f, 1.5f, -3}, {0.3f, 1.5f, 3}, {0.3f, 0, 3}, 0);
+    // The wall blocks from both sides: double-sided (a single-sided one is culled from behind).
+    Material wall = scene.materials[0];
+    wall.double_sided = true;
+    scene.materials.push_back(wall);
+    add_quad(scene, {0.3f, 0, -3}, {0.3f, 1.5f, -3}, {0.3f, 1.5f, 3}, {0.3f, 0, 3},
+             uint32_t(scene.materials.size() - 1));
     const GpuSceneData data = gpu_scene_for(scene, kCamera, settings);
     settings.estimator = "hemisphere-cosine";
     const Renders looked_up = independent_renders(device, data, settings, kRenders, kFirstSeed);

@@ -187,7 +187,9 @@ TEST_CASE("a directional light at an angle: albedo/pi x E cos, and a blocker's s
     PunctualPlane scene({directional_light({1.0f, -1.0f, 0.0f}, {2.0f, 1.5f, 1.0f})}, false);
     // A box on the floor at x in [-0.2, 0.1], z in [-0.3, 0.3], 0.5 high: the light comes from
     // −X at 45°, so its top casts a shadow on x in [0.3, 0.6], which the camera sees past it.
-    const uint32_t grey = add_material(scene.ps.scene, glm::vec3(0.5f));
+    // Double-sided: the floor's shadow rays meet the top from below (a single-sided top would
+    // be culled there and cast no shadow).
+    const uint32_t grey = add_material(scene.ps.scene, glm::vec3(0.5f), glm::vec3(0.0f), true);
     const glm::vec3 lo(-0.2f, 0.0f, -0.3f), hi(0.1f, 0.5f, 0.3f);
     add_quad(scene.ps.scene, {lo.x, hi.y, lo.z}, {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z},
              {hi.x, hi.y, lo.z}, grey);  // top, facing +Y
