@@ -100,7 +100,6 @@ void run_interruptible(const std::function<void(Job&)>& work, const py::object& 
     if (job->error) std::rethrow_exception(job->error);
 }
 
-
 size_t background_running() {
     size_t running = 0;
     std::lock_guard<std::mutex> lock(background().mutex);

@@ -30,8 +30,8 @@ struct Job {
     StopFlag interrupted{0};
     std::mutex mutex;
     std::condition_variable changed;
-    bool done = false;                                // under mutex
-    std::exception_ptr error;                         // what the work threw; set before done
+    bool done = false;                                    // under mutex
+    std::exception_ptr error;                             // what the work threw; set before done
     std::vector<std::pair<uint32_t, uint32_t>> progress;  // under mutex: not yet told
 
     // The render's ProgressSink: queues (done, total) for the calling thread.

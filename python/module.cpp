@@ -29,8 +29,8 @@
 #include "common/error.h"
 #include "image/image.h"
 #include "interruptible.h"
-#include "render/memory_estimate.h"
 #include "render/estimator_file.h"
+#include "render/memory_estimate.h"
 #include "render/session.h"
 #include "render/variants.h"
 
@@ -122,8 +122,7 @@ auto translating(F&& f, InputKind kind, const std::string& estimator = "") -> de
         const std::string what = flag_error(e).what();
         const bool of_estimator = e.setting == "estimator_file";
         // The estimator's own text, as a file's would be told without its flag.
-        input_error(of_estimator && kind == InputKind::Estimator ? e.detail : what,
-                    of_estimator);
+        input_error(of_estimator && kind == InputKind::Estimator ? e.detail : what, of_estimator);
         throw;  // not reached: input_error throws
     } catch (const InputError& e) {
         const std::string what = e.what();
@@ -176,8 +175,8 @@ RenderOptions parse_render_options(const std::string& scene, const std::string& 
     add_render_command(app, o);
     refuse_empty_values(app);
     // The output is the caller's (Result.save): a placeholder satisfies the required option.
-    std::vector<std::string> words = {"mcrt", "render", scene, "--out", "mcrt-python.exr",
-                                      "--materials", materials, "--quiet"};
+    std::vector<std::string> words = {
+        "mcrt", "render", scene, "--out", "mcrt-python.exr", "--materials", materials, "--quiet"};
     words.insert(words.end(), args.begin(), args.end());
     std::vector<char*> argv;
     for (std::string& w : words) argv.push_back(w.data());
@@ -234,10 +233,9 @@ PyResult render_scene(PyScene& self, const std::vector<std::string>& args,
                         throw PyDeviceError("the context of this scene is closed");
                     std::lock_guard<std::mutex> scene_lock(scene->use);
                     const RenderPlan plan = plan_session_render(*scene, request, warn);
-                    check_host_memory("a " + std::to_string(o.width) + "x" +
-                                          std::to_string(o.height) + " render",
-                                      render_host_bytes(o.width, o.height,
-                                                        plan.settings.replicates));
+                    check_host_memory(
+                        "a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " render",
+                        render_host_bytes(o.width, o.height, plan.settings.replicates));
                     const double seconds_to_render =
                         std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
                             .count();
@@ -304,20 +302,19 @@ PYBIND11_MODULE(_mcrt, m) {
     using namespace mcrt;
     m.doc() = "mcrt's render session (the Python API is the package mcrt)";
 
-    g_setting_error = PyErr_NewExceptionWithDoc(
-        "mcrt.SettingError", "A render setting the command line would refuse.", PyExc_ValueError,
-        nullptr);
-    g_scene_error = PyErr_NewExceptionWithDoc("mcrt.SceneError",
-                                              "A scene that cannot be read.", PyExc_ValueError,
-                                              nullptr);
+    g_setting_error = PyErr_NewExceptionWithDoc("mcrt.SettingError",
+                                                "A render setting the command line would refuse.",
+                                                PyExc_ValueError, nullptr);
+    g_scene_error = PyErr_NewExceptionWithDoc("mcrt.SceneError", "A scene that cannot be read.",
+                                              PyExc_ValueError, nullptr);
     g_estimator_error = PyErr_NewExceptionWithDoc(
         "mcrt.EstimatorError",
         "A user's estimator that is refused or does not build; `line` is its line (or None), "
         "`log` the build log.",
         PyExc_ValueError, nullptr);
-    g_device_error = PyErr_NewExceptionWithDoc(
-        "mcrt.DeviceError", "No device, or a device failure during a render.",
-        PyExc_RuntimeError, nullptr);
+    g_device_error = PyErr_NewExceptionWithDoc("mcrt.DeviceError",
+                                               "No device, or a device failure during a render.",
+                                               PyExc_RuntimeError, nullptr);
     m.add_object("SettingError", py::handle(g_setting_error));
     m.add_object("SceneError", py::handle(g_scene_error));
     m.add_object("EstimatorError", py::handle(g_estimator_error));
@@ -326,14 +323,15 @@ PYBIND11_MODULE(_mcrt, m) {
 
     m.def("devices", [] {
         std::vector<std::string> warnings;
-        std::vector<DeviceInfo> devices = enumerate_devices(
-            [&](const std::string& w) { warnings.push_back(w); });
+        std::vector<DeviceInfo> devices =
+            enumerate_devices([&](const std::string& w) { warnings.push_back(w); });
         py::list list;
         for (const DeviceInfo& d : devices) list.append(device_dict(d));
         return list;
     });
-    m.def("_wait_background", [] { join_background(true); },
-          "Waits for work that an interrupted render or load left running (called at exit).");
+    m.def(
+        "_wait_background", [] { join_background(true); },
+        "Waits for work that an interrupted render or load left running (called at exit).");
     m.def("_background_running", &background_running,
           "How many interrupted renders and loads are still running (tests).");
     m.def("variants_json", [] { return variants_json(); });
@@ -380,8 +378,9 @@ PYBIND11_MODULE(_mcrt, m) {
                                              ": expected a number in [-64, 64]");
                         py::gil_scoped_release release;
                         write_exr(path, d.result.image, exr_attributes(d.options, d.result));
-                        if (!png.empty()) write_png(path == png ? path + ".png" : png,
-                                                    d.result.image, float(exposure));
+                        if (!png.empty())
+                            write_png(path == png ? path + ".png" : png, d.result.image,
+                                      float(exposure));
                         return 0;
                     },
                     InputKind::Setting);
@@ -432,10 +431,7 @@ PYBIND11_MODULE(_mcrt, m) {
              }),
              py::arg("devices"))
         .def_property_readonly("warnings", [](const ContextState& c) { return c.warnings; })
-        .def_property_readonly("closed",
-                               [](ContextState& c) {
-                                   return c.closed.load();
-                               })
+        .def_property_readonly("closed", [](ContextState& c) { return c.closed.load(); })
         .def_property_readonly("devices",
                                [](ContextState& c) {
                                    std::unique_lock<std::mutex> lock = lock_without_gil(c.mutex);

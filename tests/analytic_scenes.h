@@ -16,7 +16,8 @@ namespace mcrt::test {
 template <typename F>
 std::vector<double> exact_pixel_image(const Camera& camera, int w, int h, int q, F value) {
     gpu::CameraGpu cam = make_gpu_camera(camera, w, h);
-    glm::dvec3 eye(cam.eye.x, cam.eye.y, cam.eye.z), fwd(cam.forward.x, cam.forward.y, cam.forward.z),
+    glm::dvec3 eye(cam.eye.x, cam.eye.y, cam.eye.z),
+        fwd(cam.forward.x, cam.forward.y, cam.forward.z),
         right(cam.right.x, cam.right.y, cam.right.z), up(cam.up.x, cam.up.y, cam.up.z);
     std::vector<double> img(3 * size_t(w) * h);
     for (int j = 0; j < h; ++j)
@@ -61,7 +62,7 @@ inline Camera looking_down(glm::vec3 eye, float yfov) {
 // horizon: E = L/2 · |Σ Θ_i (Γ_i · n)| (Lambert 1760; Arvo 1995, "Applications of Irradiance
 // Tensors", eq. 1), Θ_i the angle the edge subtends, Γ_i the unit normal of its plane through x.
 inline double lambert_irradiance(const std::vector<glm::dvec3>& polygon, glm::dvec3 x, glm::dvec3 n,
-                          double L) {
+                                 double L) {
     double sum = 0;
     for (size_t i = 0; i < polygon.size(); ++i) {
         glm::dvec3 a = glm::normalize(polygon[i] - x);

@@ -6,12 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <glm/glm.hpp>
 #include <numeric>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 namespace mcrt::test {
 

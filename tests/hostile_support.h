@@ -9,9 +9,9 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <sstream>
 #include <cstring>
 #include <filesystem>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -51,8 +51,8 @@ class Child {
                                              O_WRONLY | O_CREAT | O_TRUNC, 0644);
             posix_spawn_file_actions_adddup2(&actions, 1, 2);
         }
-        const int rc = posix_spawn(&pid_, storage[0].c_str(), &actions, nullptr, argv.data(),
-                                   envp.data());
+        const int rc =
+            posix_spawn(&pid_, storage[0].c_str(), &actions, nullptr, argv.data(), envp.data());
         posix_spawn_file_actions_destroy(&actions);
         if (fds[1] >= 0) ::close(fds[1]);
         if (rc != 0) throw std::runtime_error("posix_spawn: " + std::string(std::strerror(rc)));

@@ -6,10 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "render/gpu_scene.h"
 #include "render/renderer.h"
@@ -31,7 +30,7 @@ struct EstimatorCase {
     // Every light selection for estimators that choose a light; the default for the others.
     std::vector<std::string> selections() const {
         return uses(kUsesLightSelection) ? variant_names(kLightSelectVariants)
-                                 : std::vector<std::string>{RenderSettings().light_select};
+                                         : std::vector<std::string>{RenderSettings().light_select};
     }
     void apply(RenderSettings& s) const {
         s.estimator = row->name;
@@ -45,7 +44,8 @@ inline std::vector<EstimatorCase> estimator_cases(unsigned with, unsigned withou
     for (const EstimatorVariant& row : kEstimatorVariants) {
         if ((row.uses & with) != with || (row.uses & without) != 0) continue;
         if (row.uses & kUsesMisHeuristic)
-            for (const std::string& h : variant_names(kMisHeuristicVariants)) cases.push_back({&row, h});
+            for (const std::string& h : variant_names(kMisHeuristicVariants))
+                cases.push_back({&row, h});
         else
             cases.push_back({&row, RenderSettings().mis_heuristic});
     }
@@ -102,8 +102,9 @@ inline Renders independent_renders(const DeviceContext& device, const GpuSceneDa
         r.nan_samples += result.nan_samples;
     }
     for (size_t i = 0; i < 3 * n; ++i)
-        r.pixel_variance_observed += std::max(0.0, pixel_sum_sq[i] - pixel_sum[i] * pixel_sum[i] / count) /
-                                     double(count - 1) / double(3 * n);
+        r.pixel_variance_observed +=
+            std::max(0.0, pixel_sum_sq[i] - pixel_sum[i] * pixel_sum[i] / count) /
+            double(count - 1) / double(3 * n);
     glm::dvec3 var(0.0);
     for (const glm::dvec3& m : r.means) var += (m - r.mean) * (m - r.mean) / double(count - 1);
     r.standard_error = glm::sqrt(var / double(count));

@@ -36,10 +36,10 @@ inline void let_segv_through_sanitizer() {
 }
 
 struct ProcessResult {
-    int exit_code = -1;     // exit status when the child exited, else -1
-    int signal = 0;         // the signal that ended the child, else 0
-    bool timed_out = false; // killed by us after the timeout
-    std::string out, err;   // everything written to stdout and stderr
+    int exit_code = -1;      // exit status when the child exited, else -1
+    int signal = 0;          // the signal that ended the child, else 0
+    bool timed_out = false;  // killed by us after the timeout
+    std::string out, err;    // everything written to stdout and stderr
     double seconds = 0;
 
     bool exited() const { return exit_code >= 0; }
@@ -53,7 +53,8 @@ inline std::string read_whole_file(const std::filesystem::path& path) {
 }
 
 // Lines of `text` that start with `prefix`.
-inline std::vector<std::string> lines_starting_with(const std::string& text, const std::string& prefix) {
+inline std::vector<std::string> lines_starting_with(const std::string& text,
+                                                    const std::string& prefix) {
     std::vector<std::string> lines;
     std::istringstream in(text);
     std::string line;
@@ -67,14 +68,14 @@ inline std::string first_line(const std::string& text) { return text.substr(0, t
 // A fresh directory under the system temp directory, removed with everything in it when the
 // object goes out of scope.
 class TempDir {
-public:
+  public:
     explicit TempDir(const std::string& tag = "mcrt-test") {
         static std::atomic<unsigned> counter{0};
         auto base = std::filesystem::temp_directory_path();
         for (int attempt = 0; attempt < 1000; ++attempt) {
             auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
-            path_ = base / (tag + "-" + std::to_string(getpid()) + "-" + std::to_string(counter++) + "-" +
-                            std::to_string(stamp % 1000000007));
+            path_ = base / (tag + "-" + std::to_string(getpid()) + "-" + std::to_string(counter++) +
+                            "-" + std::to_string(stamp % 1000000007));
             if (std::filesystem::create_directory(path_)) return;
         }
         throw std::runtime_error("cannot create a temporary directory under " + base.string());
@@ -89,7 +90,7 @@ public:
     const std::filesystem::path& path() const { return path_; }
     std::string operator/(const std::string& name) const { return (path_ / name).string(); }
 
-private:
+  private:
     std::filesystem::path path_;
 };
 
@@ -98,8 +99,9 @@ private:
 // with SIGKILL and reported as timed_out. With `send_signal`, that signal is sent to the child
 // once, `signal_after` seconds after it started.
 inline ProcessResult run_process(const std::string& program, const std::vector<std::string>& args,
-                                 const std::filesystem::path& scratch, double timeout_seconds = 120.0,
-                                 int send_signal = 0, double signal_after = 0.0) {
+                                 const std::filesystem::path& scratch,
+                                 double timeout_seconds = 120.0, int send_signal = 0,
+                                 double signal_after = 0.0) {
     static std::atomic<unsigned> counter{0};
     unsigned id = counter++;
     std::string out_path = (scratch / ("stdout-" + std::to_string(id) + ".txt")).string();
@@ -116,8 +118,10 @@ inline ProcessResult run_process(const std::string& program, const std::vector<s
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 1, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
+    posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
 
     auto start = std::chrono::steady_clock::now();
     pid_t pid = 0;
@@ -130,21 +134,25 @@ inline ProcessResult run_process(const std::string& program, const std::vector<s
     for (;;) {
         pid_t done = waitpid(pid, &status, WNOHANG);
         if (done == pid) break;
-        if (done < 0 && errno != EINTR) throw std::runtime_error(std::string("waitpid: ") + std::strerror(errno));
-        double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (done < 0 && errno != EINTR)
+            throw std::runtime_error(std::string("waitpid: ") + std::strerror(errno));
+        double elapsed =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (send_signal != 0 && elapsed >= signal_after) {
             kill(pid, send_signal);
             send_signal = 0;
         }
         if (elapsed > timeout_seconds) {
             kill(pid, SIGKILL);
-            while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
+            while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+            }
             result.timed_out = true;
             break;
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
-    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
     if (WIFSIGNALED(status)) result.signal = WTERMSIG(status);
     result.out = read_whole_file(out_path);

@@ -1,8 +1,7 @@
 // The accumulator merges batch results on every core: the image must be the same bits as one
 // thread's merge, whatever the order in which the results arrive.
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -41,7 +40,8 @@ TEST_CASE("the accumulator's image is one thread's merge, bit for bit, in any ar
     // in a shuffled order.
     std::vector<BatchResult> results;
     uint64_t seq = 0;
-    auto add_item = [&](uint32_t chunk_begin, uint32_t chunk_end, uint32_t pixel_begin, uint32_t pixel_end) {
+    auto add_item = [&](uint32_t chunk_begin, uint32_t chunk_end, uint32_t pixel_begin,
+                        uint32_t pixel_end) {
         BatchResult r;
         r.item = {seq++, chunk_begin, chunk_end, pixel_begin, pixel_end};
         for (uint32_t i = 0; i < r.item.pixel_count() * r.item.chunk_count() * K; ++i)
@@ -51,7 +51,8 @@ TEST_CASE("the accumulator's image is one thread's merge, bit for bit, in any ar
     add_item(0, 2, 0, pixels);
     const uint32_t third = pixels / 3 + 1;
     for (uint32_t c = 2; c < chunks; ++c)
-        for (uint32_t p = 0; p < pixels; p += third) add_item(c, c + 1, p, std::min(pixels, p + third));
+        for (uint32_t p = 0; p < pixels; p += third)
+            add_item(c, c + 1, p, std::min(pixels, p + third));
     // One thread's merge, written out: each pixel's runs in chunk order (Chan, Golub & LeVeque).
     std::vector<double> mean(3 * size_t(pixels) * K, 0.0), m2(3 * size_t(pixels), 0.0);
     uint64_t rays = 0, vertices = 0, roulette = 0, nan = 0;
@@ -64,7 +65,8 @@ TEST_CASE("the accumulator's image is one thread's merge, bit for bit, in any ar
             const uint32_t item_chunks = r->item.chunk_count();
             for (uint32_t p = 0; p < r->item.pixel_count(); ++p)
                 for (uint32_t k = 0; k < K; ++k) {
-                    const gpu::ChunkSums& s = r->sums[(size_t(p) * item_chunks + (c - r->item.chunk_begin)) * K + k];
+                    const gpu::ChunkSums& s =
+                        r->sums[(size_t(p) * item_chunks + (c - r->item.chunk_begin)) * K + k];
                     const size_t at = 3 * ((size_t(r->item.pixel_begin) + p) * K + k);
                     const float shift[3] = {s.shift.x, s.shift.y, s.shift.z};
                     const float sum[3] = {s.sum.x, s.sum.y, s.sum.z};
@@ -77,7 +79,8 @@ TEST_CASE("the accumulator's image is one thread's merge, bit for bit, in any ar
                         mean[at + ch] += delta * (n_b / n_total);
                         if (K == 1) {
                             const double d = double(sum[ch]);
-                            const double row_m2 = std::max(0.0, double(sum_sq[ch]) - d * d / n) * scale * scale;
+                            const double row_m2 =
+                                std::max(0.0, double(sum_sq[ch]) - d * d / n) * scale * scale;
                             m2[at + ch] += row_m2 + delta * delta * (n_a * n_b / n_total);
                         }
                     }

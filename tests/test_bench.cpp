@@ -119,8 +119,8 @@ TEST_CASE("bench --rays runs one kind; the table is the default output", "[bench
 
 TEST_CASE("bench --bvh-max-leaf and --bvh-traversal-cost shape the tree, not the hits", "[bench]") {
     auto primary = [](std::vector<std::string> extra) {
-        std::vector<std::string> args = {kCornell, "--rays", "primary", "--width", "48",
-                                         "--height", "48", "--repeats", "1", "--json"};
+        std::vector<std::string> args = {kCornell,   "--rays", "primary",   "--width", "48",
+                                         "--height", "48",     "--repeats", "1",       "--json"};
         args.insert(args.end(), extra.begin(), extra.end());
         ProcessResult r = run_bench(args);
         INFO(r.err);

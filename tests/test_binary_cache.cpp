@@ -1,10 +1,9 @@
 // The on-disk kernel binary cache: hits, misses, keys, and that it never fails a build.
-#include <catch2/catch.hpp>
-
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <catch2/catch.hpp>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -14,14 +13,14 @@
 #include <string>
 #include <vector>
 
-#include "render/renderer.h"
-#include "render/variants.h"
 #include "cl/binary_cache.h"
 #include "cl/build_child.h"
 #include "cl/cl_error.h"
 #include "cl/pocl_binary.h"
 #include "cl/program.h"
 #include "device_support.h"
+#include "render/renderer.h"
+#include "render/variants.h"
 
 using namespace mcrt;
 using mcrt::test::first_device;
@@ -139,11 +138,11 @@ std::vector<unsigned char> synthetic_pocl_binary(size_t bc) {
     };
     const std::string magic("poclbin\0", 8), path = "/program.bc";
     b.insert(b.end(), magic.begin(), magic.end());
-    u64(0x1234);  // device id
-    u32(9);       // version
-    u32(1);       // kernels
-    u64(0);       // flags
-    u32(1);       // root entries
+    u64(0x1234);                 // device id
+    u32(9);                      // version
+    u32(1);                      // kernels
+    u64(0);                      // flags
+    u32(1);                      // root entries
     b.insert(b.end(), 41, 'a');  // build hash
     u64(bc == 0 ? 0 : 4 + path.size() + 4 + bc);
     if (bc > 0) {
@@ -266,8 +265,8 @@ TEST_CASE("with store_after_misses 3 the third miss stores the binary, the fourt
     for (int build_number = 1; build_number <= 4; ++build_number) {
         INFO("build " << build_number);
         BuildReport report;
-        cl::Program program = build_program_cached(device.context, device.info.device,
-                                                   device.info, kSource, kOptions, &report, 3);
+        cl::Program program = build_program_cached(device.context, device.info.device, device.info,
+                                                   kSource, kOptions, &report, 3);
         check_runs(device, program, 2.0f, 1.0f);
         const bool stored = fs::exists(report.path);
         CHECK(report.cache_hit == (build_number == 4));
@@ -363,9 +362,9 @@ TEST_CASE("a corrupt entry is rebuilt from source and replaced", "[cache]") {
         // PoCL serialises such a binary while another process rewrites its cache, and aborts the
         // process when asked to build it (pocl_binary_get_kernels_metadata: `len > 0').
         const std::vector<unsigned char> payload(valid.begin() + 40, valid.end());
-        const bool pocl = pocl_binary_problem(payload).empty() &&
-                          std::string(valid.begin() + 40, valid.begin() + 48) ==
-                              std::string("poclbin\0", 8);
+        const bool pocl =
+            pocl_binary_problem(payload).empty() &&
+            std::string(valid.begin() + 40, valid.begin() + 48) == std::string("poclbin\0", 8);
         const std::vector<unsigned char> broken =
             pocl ? without_program_bc(payload) : synthetic_pocl_binary(0);
         BinaryCacheKey key = binary_cache_key(device.info, kSource, kOptions);
@@ -511,7 +510,8 @@ TEST_CASE("the cache never follows, blocks on or keeps what is planted at an ent
     DeviceContext device = first_device();
     TempCache cache;
     fs::create_directories(cache.dir);
-    const fs::path victim_dir = cache.dir.parent_path() / (cache.dir.filename().string() + "-victim");
+    const fs::path victim_dir =
+        cache.dir.parent_path() / (cache.dir.filename().string() + "-victim");
     fs::create_directories(victim_dir);
     struct RemoveVictims {
         fs::path dir;
@@ -590,7 +590,8 @@ TEST_CASE("the cache never follows, blocks on or keeps what is planted at an ent
         CHECK(file.filename().string().find(".tmp-") == std::string::npos);
 }
 
-TEST_CASE("a stale temporary of a killed writer is swept from the cache directory", "[cache][hostile]") {
+TEST_CASE("a stale temporary of a killed writer is swept from the cache directory",
+          "[cache][hostile]") {
     DeviceContext device = first_device();
     TempCache cache;
     fs::create_directories(cache.dir);
@@ -610,7 +611,8 @@ TEST_CASE("a stale temporary of a killed writer is swept from the cache director
 }
 
 TEST_CASE("mcrt build-program run by hand replaces nothing and says why", "[cache][hostile]") {
-    const fs::path dir = fs::temp_directory_path() / ("mcrt-user-dir-" + std::to_string(::getpid()));
+    const fs::path dir =
+        fs::temp_directory_path() / ("mcrt-user-dir-" + std::to_string(::getpid()));
     fs::create_directories(dir);
     std::ofstream(dir / "binary") << "the user's";
     std::ofstream(dir / "error") << "also the user's";
@@ -638,7 +640,8 @@ TEST_CASE("mcrt build-program run by hand replaces nothing and says why", "[cach
         CHECK(code == 2);
         CHECK_THAT(out, Catch::Contains("No such file or directory"));
     }
-    CHECK(read_bytes(dir / "binary") == std::vector<char>{'t', 'h', 'e', ' ', 'u', 's', 'e', 'r', '\'', 's'});
+    CHECK(read_bytes(dir / "binary") ==
+          std::vector<char>{'t', 'h', 'e', ' ', 'u', 's', 'e', 'r', '\'', 's'});
     CHECK(read_bytes(dir / "error").size() == 15);
     std::error_code ec;
     fs::remove_all(dir, ec);
@@ -650,11 +653,13 @@ TEST_CASE("a build directory left by a killed render is removed by the next chil
     if (dead == 0) ::_exit(0);
     int status = 0;
     REQUIRE(::waitpid(dead, &status, 0) == dead);
-    const fs::path stale = fs::temp_directory_path() / ("mcrt-build-" + std::to_string(dead) + "-a1B2c3");
+    const fs::path stale =
+        fs::temp_directory_path() / ("mcrt-build-" + std::to_string(dead) + "-a1B2c3");
     fs::create_directories(stale);
     std::ofstream(stale / "source.cl") << kSource;
     // A directory of a live process (this one) under the same pattern stays.
-    const fs::path alive = fs::temp_directory_path() / ("mcrt-build-" + std::to_string(::getpid()) + "-zZ9yY8");
+    const fs::path alive =
+        fs::temp_directory_path() / ("mcrt-build-" + std::to_string(::getpid()) + "-zZ9yY8");
     fs::create_directories(alive);
     DeviceContext device = first_device();
     const std::vector<unsigned char> binary = build_binary_in_child(device.info, kSource, kOptions);

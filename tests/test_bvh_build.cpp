@@ -294,9 +294,9 @@ void validate4(const Bvh& bvh, const BvhBuildOptions& options) {
     CHECK(depth <= kMaxBvh4Depth);
     CHECK(depth <= std::max(1, bvh.stats.depth - 1));
     CHECK(bvh.stats.sah_cost4 == Approx(cost).epsilon(1e-6));
-    CHECK(bvh.stats.bytes == bvh.nodes4.size() * sizeof(gpu::Bvh4Node) +
-                                 bvh.packets.size() * (sizeof(gpu::TrianglePacket) +
-                                                       4 * sizeof(gpu::TriangleInfo)));
+    CHECK(bvh.stats.bytes ==
+          bvh.nodes4.size() * sizeof(gpu::Bvh4Node) +
+              bvh.packets.size() * (sizeof(gpu::TrianglePacket) + 4 * sizeof(gpu::TriangleInfo)));
     if (n == 0) {
         for (int s = 0; s < 4; ++s) CHECK(is_empty_slot(bvh.nodes4[0], s));
         CHECK(bvh.stats.sah_cost4 == 0.0);
@@ -320,7 +320,8 @@ void validate(const Scene& scene, const Bvh& bvh, const BvhBuildOptions& options
         }
         ++seen[id];
         const glm::vec3* p = &scene.positions[3 * size_t(id)];
-        bool ok = tri.material == scene.triangle_material[id] && glm::vec3(tri.p0.x, tri.p0.y, tri.p0.z) == p[0] &&
+        bool ok = tri.material == scene.triangle_material[id] &&
+                  glm::vec3(tri.p0.x, tri.p0.y, tri.p0.z) == p[0] &&
                   glm::vec3(tri.p1.x, tri.p1.y, tri.p1.z) == p[1] &&
                   glm::vec3(tri.p2.x, tri.p2.y, tri.p2.z) == p[2];
         if (!ok) ++bad_triangles;

@@ -1,6 +1,5 @@
 // The OpenCL host layer: devices, errors, kernel sources, builds, shared struct layouts.
 #include <catch2/catch.hpp>
-
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -71,16 +70,18 @@ TEST_CASE("MCRT_KERNEL_DIR reads kernels from disk instead of the embedded copy"
     std::string src = kernel_source("a.cl");
     CHECK_THROWS_AS(kernel_source("missing.cl"), RuntimeError);
     unsetenv("MCRT_KERNEL_DIR");
-    CHECK(src == "#line 1 \"a.cl\"\n#line 1 \"b.h\"\n#define FROM_DISK 1\n#line 2 \"a.cl\"\n"
-                 "kernel void a() {}\n");
+    CHECK(src ==
+          "#line 1 \"a.cl\"\n#line 1 \"b.h\"\n#define FROM_DISK 1\n#line 2 \"a.cl\"\n"
+          "kernel void a() {}\n");
     CHECK_THROWS_AS(kernel_source("a.cl"), RuntimeError);  // not embedded
     std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("a failing build raises an error carrying the build log and the right line", "[cl]") {
     DeviceContext device = first_device();
-    std::string source = "#line 1 \"broken.cl\"\nkernel void k(global float* x) {\n"
-                         "    x[0] = undefined_name;\n}\n";
+    std::string source =
+        "#line 1 \"broken.cl\"\nkernel void k(global float* x) {\n"
+        "    x[0] = undefined_name;\n}\n";
     try {
         build_program(device.context, device.info.device, source, "");
         FAIL("the broken kernel built");
@@ -98,7 +99,7 @@ TEST_CASE("the device sees every shared struct with the host's size, alignment a
     // The host's view, from the same list the device probe walks (MCRT_SHARED_LAYOUT).
     std::vector<cl_uint> want;
     std::vector<std::string> what;
-#define HOST_TYPE(T, size, align)                    \
+#define HOST_TYPE(T, size, align)                            \
     want.push_back(sizeof(T)), what.push_back("sizeof " #T); \
     want.push_back(alignof(T)), what.push_back("alignof " #T);
 #define HOST_FIELD(T, member, offset) \
@@ -112,12 +113,14 @@ TEST_CASE("the device sees every shared struct with the host's size, alignment a
     cl::Program program = cached_program(device, "render.cl", default_render_options());
     cl::Kernel kernel = make_kernel(program, "shared_type_layout");
     cl_int status;
-    cl::Buffer layout(device.context, CL_MEM_WRITE_ONLY, want.size() * sizeof(cl_uint), nullptr, &status);
+    cl::Buffer layout(device.context, CL_MEM_WRITE_ONLY, want.size() * sizeof(cl_uint), nullptr,
+                      &status);
     REQUIRE(status == CL_SUCCESS);
     CL_CHECK(kernel.setArg(0, layout));
     CL_CHECK(device.queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(1)));
     std::vector<cl_uint> got(want.size());
-    CL_CHECK(device.queue.enqueueReadBuffer(layout, CL_TRUE, 0, got.size() * sizeof(cl_uint), got.data()));
+    CL_CHECK(device.queue.enqueueReadBuffer(layout, CL_TRUE, 0, got.size() * sizeof(cl_uint),
+                                            got.data()));
     for (size_t k = 0; k < want.size(); ++k) {
         INFO(what[k] << ": host " << want[k] << ", device " << got[k]);
         CHECK(got[k] == want[k]);

@@ -16,8 +16,8 @@
 #include "cli/render_command.h"
 #include "common/environment.h"
 #include "image/image.h"
-#include "render/variants.h"
 #include "process_support.h"
+#include "render/variants.h"
 #include "test_support.h"
 
 namespace fs = std::filesystem;
@@ -29,7 +29,8 @@ namespace {
 const std::string kCornell = std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf";
 
 // Small and fast: every render in this file uses these unless a test says otherwise.
-const std::vector<std::string> kSmall = {"--width", "32", "--height", "32", "--spp", "4", "--quiet"};
+const std::vector<std::string> kSmall = {"--width", "32", "--height", "32",
+                                         "--spp",   "4",  "--quiet"};
 
 std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
     a.insert(a.end(), b.begin(), b.end());
@@ -56,7 +57,7 @@ struct Sandbox {
         ProcessResult r = run_process(MCRT_EXE, args, tmp.path(), timeout_seconds);
         INFO(describe(args) << "\n  exit " << r.exit_code << ", signal " << r.signal << ", "
                             << r.seconds << " s\n  stdout: " << r.out << "\n  stderr: " << r.err);
-        CHECK_FALSE(r.timed_out);  // a hang
+        CHECK_FALSE(r.timed_out);                // a hang
         if (!r.timed_out) CHECK(r.signal == 0);  // a crash
         return r;
     }
@@ -106,7 +107,8 @@ double mean(const std::vector<float>& v) {
     return v.empty() ? 0.0 : sum / double(v.size());
 }
 
-Image render_cornell(const Sandbox& box, const std::string& name, const std::vector<std::string>& extra) {
+Image render_cornell(const Sandbox& box, const std::string& name,
+                     const std::vector<std::string>& extra) {
     std::string exr = box.out(name);
     ProcessResult r = box.run(concat({"render", kCornell, "--out", exr}, extra));
     INFO(describe(extra) << "\nstderr: " << r.err);
@@ -160,8 +162,9 @@ std::string check_robust_render(const fs::path& scene) {
     if (errors.empty()) return "rejected without an error line";
     std::string message = errors.front();
     size_t named = message.find(scene.filename().string() + ": ");
-    return "rejected: " + (named == std::string::npos ? message
-                                                       : message.substr(named + scene.filename().string().size() + 2));
+    return "rejected: " + (named == std::string::npos
+                               ? message
+                               : message.substr(named + scene.filename().string().size() + 2));
 }
 
 }  // namespace
@@ -178,9 +181,9 @@ TEST_CASE("mcrt render writes the EXR, PNG and stats it is asked for", "[cli]") 
     Sandbox box;
     const int width = 32, height = 24, spp = 4;
     std::string exr = box.out("c.exr"), png = box.out("c.png"), stats = box.out("s.json");
-    ProcessResult r = box.run({"render", kCornell, "--out", exr, "--png", png, "--stats", stats, "--width",
-                               std::to_string(width), "--height", std::to_string(height), "--spp",
-                               std::to_string(spp), "--quiet"});
+    ProcessResult r = box.run({"render", kCornell, "--out", exr, "--png", png, "--stats", stats,
+                               "--width", std::to_string(width), "--height", std::to_string(height),
+                               "--spp", std::to_string(spp), "--quiet"});
     INFO("stderr: " << r.err);
     REQUIRE(r.exit_code == 0);
     CHECK(lines_starting_with(r.err, "mcrt: error:").empty());
@@ -194,7 +197,8 @@ TEST_CASE("mcrt render writes the EXR, PNG and stats it is asked for", "[cli]") 
         REQUIRE(image.rgb.size() == size_t(3 * width * height));
         REQUIRE(image.variance.size() == image.rgb.size());
         bool finite_non_negative = true;
-        for (float x : image.rgb) finite_non_negative = finite_non_negative && std::isfinite(x) && x >= 0;
+        for (float x : image.rgb)
+            finite_non_negative = finite_non_negative && std::isfinite(x) && x >= 0;
         CHECK(finite_non_negative);
         CHECK(mean(image.rgb) > 0);
         bool variance_ok = true, variance_nonzero = false;
@@ -213,9 +217,9 @@ TEST_CASE("mcrt render writes the EXR, PNG and stats it is asked for", "[cli]") 
         REQUIRE(fs::exists(stats));
         nlohmann::json j;
         REQUIRE_NOTHROW(j = nlohmann::json::parse(read_whole_file(stats)));
-        for (const char* key : {"scene", "width", "height", "spp", "estimator", "light_select", "sampler", "seed",
-                                "devices", "seconds_total", "seconds_render", "samples_per_second",
-                                "rays_per_second", "nan_samples"}) {
+        for (const char* key : {"scene", "width", "height", "spp", "estimator", "light_select",
+                                "sampler", "seed", "devices", "seconds_total", "seconds_render",
+                                "samples_per_second", "rays_per_second", "nan_samples"}) {
             INFO("key " << key);
             CHECK(j.contains(key));
         }
@@ -252,64 +256,98 @@ TEST_CASE("bad usage exits 2 with one error line and writes nothing", "[cli]") {
     };
     const std::vector<std::string> out = {"--out", "@D/x.exr"};
     const std::vector<std::string> cases_scene = {"render", kCornell};
-    auto render = [&](std::vector<std::string> extra) { return concat(concat(cases_scene, out), extra); };
+    auto render = [&](std::vector<std::string> extra) {
+        return concat(concat(cases_scene, out), extra);
+    };
     const std::vector<Case> cases = {
         {"unknown option", render({"--bogus"}), {"--bogus"}},
-        {"unknown estimator", render({"--estimator", "nope"}),
-         {"nope", "hemisphere-uniform", "hemisphere-cosine", "light-area", "light-solid-angle", "mis"}},
+        {"unknown estimator",
+         render({"--estimator", "nope"}),
+         {"nope", "hemisphere-uniform", "hemisphere-cosine", "light-area", "light-solid-angle",
+          "mis"}},
         {"width 0", render({"--width", "0"}), {"--width"}},
         {"width -3", render({"--width", "-3"}), {"--width"}},
         {"spp 0", render({"--spp", "0"}), {"--spp"}},
         {"spp abc", render({"--spp", "abc"}), {"--spp"}},
         {"missing --out", concat(cases_scene, {"--quiet"}), {"--out"}},
         {"no subcommand", {}, {}},
-        {"--out into a missing directory", concat(cases_scene, {"--out", "@D/missing/x.exr"}),
+        {"--out into a missing directory",
+         concat(cases_scene, {"--out", "@D/missing/x.exr"}),
          {"--out", "@D/missing"}},
-        {"--png into a missing directory", render({"--png", "@D/missing/x.png"}), {"--png", "@D/missing"}},
-        {"missing scene file", {"render", "@D/no such scene.gltf", "--out", "@D/x.exr"}, {"no such scene.gltf"}},
-        {"unknown light selection", render({"--light-select", "nope"}), {"nope", "uniform", "power", "alias"}},
-        {"unknown sampler", render({"--sampler", "nope"}), {"nope", "independent", "stratified", "sobol"}},
-        {"unknown MIS heuristic", render({"--mis-heuristic", "nope"}), {"nope", "balance", "power"}},
+        {"--png into a missing directory",
+         render({"--png", "@D/missing/x.png"}),
+         {"--png", "@D/missing"}},
+        {"missing scene file",
+         {"render", "@D/no such scene.gltf", "--out", "@D/x.exr"},
+         {"no such scene.gltf"}},
+        {"unknown light selection",
+         render({"--light-select", "nope"}),
+         {"nope", "uniform", "power", "alias"}},
+        {"unknown sampler",
+         render({"--sampler", "nope"}),
+         {"nope", "independent", "stratified", "sobol"}},
+        {"unknown MIS heuristic",
+         render({"--mis-heuristic", "nope"}),
+         {"nope", "balance", "power"}},
         {"camera out of range", render({"--camera", "5"}), {"--camera"}},
         {"device 99", render({"--device", "99"}), {"--device", "99"}},
         {"device bogus", render({"--device", "bogus"}), {"--device", "bogus"}},
         {"sky -1", render({"--sky", "-1"}), {"--sky"}},
         {"sky with two values", render({"--sky", "1,2"}), {"--sky"}},
         {"replicates 3", render({"--replicates", "3"}), {"--replicates", "3"}},
-        {"replicates not dividing spp", render({"--replicates", "8", "--spp", "12"}), {"--replicates", "12"}},
+        {"replicates not dividing spp",
+         render({"--replicates", "8", "--spp", "12"}),
+         {"--replicates", "12"}},
         {"replicates 32", render({"--replicates", "32"}), {"--replicates"}},
         {"max depth beyond the bound", render({"--max-depth", "1025"}), {"--max-depth"}},
         {"max depth -1", render({"--max-depth", "-1"}), {"--max-depth"}},
         {"rr depth 0", render({"--rr-depth", "0"}), {"--rr-depth"}},
-        {"ambient estimator with paths", render({"--estimator", "ambient-cosine", "--max-depth", "2"}),
+        {"ambient estimator with paths",
+         render({"--estimator", "ambient-cosine", "--max-depth", "2"}),
          {"--max-depth", "ambient-cosine"}},
         {"look-from without look-at", render({"--look-from", "0,1,2"}), {"--look-at"}},
         {"look-at without look-from", render({"--look-at", "0,1,2"}), {"--look-from"}},
         {"fov without look-from", render({"--fov", "30"}), {"--look-from"}},
-        {"look-from with two values", render({"--look-from", "0,1", "--look-at", "0,0,0"}), {"--look-from"}},
-        {"look-from not a number", render({"--look-from", "a,b,c", "--look-at", "0,0,0"}), {"--look-from"}},
-        {"look-from nan", render({"--look-from", "nan,0,0", "--look-at", "0,0,0"}), {"--look-from"}},
-        {"look-from equal to look-at", render({"--look-from", "1,2,3", "--look-at", "1,2,3"}),
+        {"look-from with two values",
+         render({"--look-from", "0,1", "--look-at", "0,0,0"}),
+         {"--look-from"}},
+        {"look-from not a number",
+         render({"--look-from", "a,b,c", "--look-at", "0,0,0"}),
+         {"--look-from"}},
+        {"look-from nan",
+         render({"--look-from", "nan,0,0", "--look-at", "0,0,0"}),
+         {"--look-from"}},
+        {"look-from equal to look-at",
+         render({"--look-from", "1,2,3", "--look-at", "1,2,3"}),
          {"--look-at", "--look-from"}},
-        {"up parallel to the view", render({"--look-from", "0,5,0", "--look-at", "0,0,0", "--up", "0,1,0"}),
+        {"up parallel to the view",
+         render({"--look-from", "0,5,0", "--look-at", "0,0,0", "--up", "0,1,0"}),
          {"--up", "parallel"}},
-        {"up zero", render({"--look-from", "0,5,1", "--look-at", "0,0,0", "--up", "0,0,0"}), {"--up"}},
-        {"fov 180", render({"--look-from", "0,1,5", "--look-at", "0,1,0", "--fov", "180"}), {"--fov"}},
-        {"look-from with --camera", render({"--look-from", "0,1,5", "--look-at", "0,1,0", "--camera", "0"}),
+        {"up zero",
+         render({"--look-from", "0,5,1", "--look-at", "0,0,0", "--up", "0,0,0"}),
+         {"--up"}},
+        {"fov 180",
+         render({"--look-from", "0,1,5", "--look-at", "0,1,0", "--fov", "180"}),
+         {"--fov"}},
+        {"look-from with --camera",
+         render({"--look-from", "0,1,5", "--look-at", "0,1,0", "--camera", "0"}),
          {"--look-from", "--camera"}},
         {"bench: up parallel to the view",
-         {"bench", kCornell, "--look-from", "0,5,0", "--look-at", "0,0,0", "--width", "8", "--height", "8"},
+         {"bench", kCornell, "--look-from", "0,5,0", "--look-at", "0,0,0", "--width", "8",
+          "--height", "8"},
          {"--up", "parallel"}},
     };
     for (const Case& c : cases) {
         Sandbox box;
         auto expand = [&](std::string s) {
-            for (size_t at; (at = s.find("@D")) != std::string::npos;) s.replace(at, 2, box.out_dir.string());
+            for (size_t at; (at = s.find("@D")) != std::string::npos;)
+                s.replace(at, 2, box.out_dir.string());
             return s;
         };
         std::vector<std::string> args;
         for (const std::string& a : c.args) args.push_back(expand(a));
-        if (!args.empty() && args[0] == "render") args = concat(args, {"--width", "8", "--height", "8", "--quiet"});
+        if (!args.empty() && args[0] == "render")
+            args = concat(args, {"--width", "8", "--height", "8", "--quiet"});
         ProcessResult r = box.run(args);
         INFO("case: " << c.name << "\n  " << describe(args) << "\n  stderr: " << r.err);
         check_usage_error(r);
@@ -327,7 +365,8 @@ TEST_CASE("path tracing from the command line: depth, roulette, the sky light, a
     Sandbox box;
     const std::string exr = box.out("x.exr"), stats = box.out("x.json");
     auto run = [&](std::vector<std::string> extra) {
-        ProcessResult r = box.run(concat(concat({"render", kCornell, "--out", exr, "--stats", stats}, kSmall), extra));
+        ProcessResult r = box.run(
+            concat(concat({"render", kCornell, "--out", exr, "--stats", stats}, kSmall), extra));
         INFO(describe(extra) << "\n  stderr: " << r.err);
         REQUIRE(r.exit_code == 0);
         return nlohmann::json::parse(read_whole_file(stats));
@@ -344,15 +383,17 @@ TEST_CASE("path tracing from the command line: depth, roulette, the sky light, a
     // Indirect light adds to the box: the ceiling is no longer black.
     CHECK(paths["image_mean"][0].get<double>() > direct["image_mean"][0].get<double>());
     // The sky lights nothing inside the closed box but is seen through its open front.
-    nlohmann::json sky = run({"--sky", "0.5", "--look-from", "0,1,6", "--look-at", "0,1,0", "--fov", "60"});
+    nlohmann::json sky =
+        run({"--sky", "0.5", "--look-from", "0,1,6", "--look-at", "0,1,0", "--fov", "60"});
     CHECK(sky["sky_light"] == true);
     CHECK(sky["image_mean"][0].get<double>() > 0.0);
     nlohmann::json black = run({"--look-from", "0,1,6", "--look-at", "0,1,0", "--fov", "60"});
     CHECK(black["sky_light"] == false);
     CHECK(sky["image_mean"][0].get<double>() > black["image_mean"][0].get<double>());
     // bench takes the same camera.
-    ProcessResult bench = box.run({"bench", kCornell, "--look-from", "0,1,6", "--look-at", "0,1,0",
-                                   "--width", "16", "--height", "16", "--rays", "primary", "--repeats", "1"});
+    ProcessResult bench =
+        box.run({"bench", kCornell, "--look-from", "0,1,6", "--look-at", "0,1,0", "--width", "16",
+                 "--height", "16", "--rays", "primary", "--repeats", "1"});
     INFO(bench.err);
     CHECK(bench.exit_code == 0);
     CHECK(bench.out.find("--look-from") != std::string::npos);
@@ -379,9 +420,10 @@ TEST_CASE("every estimator, light selection and sampler renders from the command
     for (const std::string& g : samplers) runs.push_back({"light-area", "power", g});
     for (const auto& [estimator, select, sampler] : runs) {
         Sandbox box;
-        ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("x.exr"), "--estimator",
-                                          estimator, "--light-select", select, "--sampler", sampler},
-                                         kSmall));
+        ProcessResult r =
+            box.run(concat({"render", kCornell, "--out", box.out("x.exr"), "--estimator", estimator,
+                            "--light-select", select, "--sampler", sampler},
+                           kSmall));
         INFO(estimator << " / " << select << " / " << sampler << "\n  stderr: " << r.err);
         REQUIRE(r.exit_code == 0);
         Image img = read_exr(box.out("x.exr"));
@@ -398,7 +440,8 @@ TEST_CASE("a rejected render leaves an existing output untouched", "[cli]") {
     Sandbox box;
     std::string exr = box.out("x.exr");
     std::ofstream(exr) << "keep";
-    ProcessResult r = box.run(concat({"render", std::string(MCRT_TEST_DATA) + "/nan_position.gltf", "--out", exr}, kSmall));
+    ProcessResult r = box.run(concat(
+        {"render", std::string(MCRT_TEST_DATA) + "/nan_position.gltf", "--out", exr}, kSmall));
     check_usage_error(r);
     CHECK(read_whole_file(exr) == "keep");
     INFO("files: " << joined(box.files()));
@@ -421,8 +464,8 @@ TEST_CASE("output paths with spaces reach mcrt intact", "[cli]") {
 TEST_CASE("NaN option values are rejected", "[cli]") {
     for (const char* option : {"--exposure", "--ao-distance", "--time-limit"}) {
         Sandbox box;
-        ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("x.exr"), "--png", box.out("x.png"),
-                                          option, "nan"},
+        ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("x.exr"), "--png",
+                                          box.out("x.png"), option, "nan"},
                                          kSmall));
         INFO(option << " nan\n  stderr: " << r.err);
         check_usage_error(r);
@@ -442,9 +485,8 @@ TEST_CASE("floating-point option values are refused with their true reason", "[c
         {"12s", "'12s' is not a number"}};
     for (const auto& [value, said] : refused) {
         Sandbox box;
-        ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("x.exr"),
-                                          "--time-limit", value},
-                                         kSmall));
+        ProcessResult r = box.run(
+            concat({"render", kCornell, "--out", box.out("x.exr"), "--time-limit", value}, kSmall));
         INFO(value << "\n  stderr: " << r.err);
         check_usage_error(r);
         CHECK(r.err.find(std::string("--time-limit: ") + said) != std::string::npos);
@@ -453,10 +495,10 @@ TEST_CASE("floating-point option values are refused with their true reason", "[c
     // A float option too: an --ao-distance that rounds to 0 in float would be "unbounded".
     {
         Sandbox box;
-        ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("x.exr"),
-                                          "--estimator", "ambient-uniform", "--ao-distance",
-                                          "1e-50"},
-                                         kSmall));
+        ProcessResult r =
+            box.run(concat({"render", kCornell, "--out", box.out("x.exr"), "--estimator",
+                            "ambient-uniform", "--ao-distance", "1e-50"},
+                           kSmall));
         INFO(r.err);
         check_usage_error(r);
         CHECK(r.err.find("--ao-distance: '1e-50' is too small to tell from 0 (the smallest is "
@@ -472,9 +514,8 @@ TEST_CASE("floating-point option values are refused with their true reason", "[c
                                             kSmall));
         INFO(tiny.err);
         CHECK(tiny.exit_code == 0);
-        ProcessResult comma = box.run(concat({"render", kCornell, "--out", box.out("y.exr"),
-                                              "--sky", "1,"},
-                                             kSmall));
+        ProcessResult comma =
+            box.run(concat({"render", kCornell, "--out", box.out("y.exr"), "--sky", "1,"}, kSmall));
         INFO(comma.err);
         check_usage_error(comma);
         CHECK(comma.err.find("--sky 1,: expected R,G,B or one value") != std::string::npos);
@@ -483,9 +524,9 @@ TEST_CASE("floating-point option values are refused with their true reason", "[c
     // its first chunk row (the supervisor is told the limit with every digit, not "0.000000").
     Sandbox box;
     const std::string exr = box.out("t.exr"), stats = box.out("t.json");
-    ProcessResult r = box.run({"render", kCornell, "--out", exr, "--stats", stats, "--width", "16",
-                               "--height", "16", "--spp", "65536", "--quiet", "--time-limit",
-                               "4.9e-324"});
+    ProcessResult r =
+        box.run({"render", kCornell, "--out", exr, "--stats", stats, "--width", "16", "--height",
+                 "16", "--spp", "65536", "--quiet", "--time-limit", "4.9e-324"});
     INFO("stderr: " << r.err);
     REQUIRE(r.exit_code == 0);
     const nlohmann::json j = nlohmann::json::parse(read_whole_file(stats));
@@ -494,11 +535,13 @@ TEST_CASE("floating-point option values are refused with their true reason", "[c
     CHECK(j["spp"].get<int>() >= 16);
 }
 
-TEST_CASE("broken and valid glTF files in tests/data render or are rejected cleanly", "[cli][robustness]") {
+TEST_CASE("broken and valid glTF files in tests/data render or are rejected cleanly",
+          "[cli][robustness]") {
     std::vector<fs::path> files = gltf_files(MCRT_TEST_DATA, false);
     REQUIRE_FALSE(files.empty());
     std::string summary;
-    for (const fs::path& f : files) summary += "\n  " + f.filename().string() + ": " + check_robust_render(f);
+    for (const fs::path& f : files)
+        summary += "\n  " + f.filename().string() + ": " + check_robust_render(f);
     WARN("tests/data:" << summary);
 }
 
@@ -519,7 +562,8 @@ TEST_CASE("mcrt render --help lists the options and their defaults", "[cli]") {
     ProcessResult r = box.run({"render", "--help"});
     INFO("stdout: " << r.out << "\nstderr: " << r.err);
     CHECK(r.exit_code == 0);
-    for (const char* text : {"--estimator", "--out", "--spp", "512", "16", "light-area", "power", "independent"}) {
+    for (const char* text :
+         {"--estimator", "--out", "--spp", "512", "16", "light-area", "power", "independent"}) {
         INFO("help should mention " << text);
         CHECK(r.out.find(text) != std::string::npos);
     }
@@ -535,7 +579,8 @@ TEST_CASE("renders are deterministic end to end", "[cli][determinism]") {
         CHECK(same_bits(a.variance, b.variance));
     }
     SECTION("batch size does not change the image") {
-        const std::vector<std::string> common = {"--width", "32", "--height", "32", "--spp", "40", "--quiet"};
+        const std::vector<std::string> common = {"--width", "32", "--height", "32",
+                                                 "--spp",   "40", "--quiet"};
         Image a = render_cornell(box, "a.exr", concat(common, {"--batch", "16"}));
         Image b = render_cornell(box, "b.exr", concat(common, {"--batch", "48"}));
         Image c = render_cornell(box, "c.exr", concat(common, {"--batch", "1"}));
@@ -562,7 +607,8 @@ TEST_CASE("a scene without emitters renders black with a warning", "[cli][shared
     REQUIRE(r.exit_code == 0);
     std::vector<std::string> warnings = lines_starting_with(r.err, "mcrt: warning:");
     bool mentions_emissive = false;
-    for (const std::string& w : warnings) mentions_emissive = mentions_emissive || w.find("emissive") != std::string::npos;
+    for (const std::string& w : warnings)
+        mentions_emissive = mentions_emissive || w.find("emissive") != std::string::npos;
     CHECK(mentions_emissive);
     Image image = read_exr(exr);
     bool black = true;
@@ -624,12 +670,14 @@ TEST_CASE("the EXR and the stats say which variance estimate the layer holds", "
         std::ifstream in(box.out("x.json"));
         nlohmann::json j = nlohmann::json::parse(in);
         CHECK(std::to_string(j["replicates"].get<int>()) == replicates);
-        CHECK(j["variance_estimate"] == (std::string(replicates) == "1" ? "samples" : "replicates"));
+        CHECK(j["variance_estimate"] ==
+              (std::string(replicates) == "1" ? "samples" : "replicates"));
         std::ifstream exr(box.out("x.exr"), std::ios::binary);
         std::string bytes((std::istreambuf_iterator<char>(exr)), std::istreambuf_iterator<char>());
         CHECK(bytes.find("mcrt.replicates") != std::string::npos);
-        CHECK(bytes.find(std::string(replicates) == "1" ? "the samples' variance over their number"
-                                                        : "independent replicate means") != std::string::npos);
+        CHECK(bytes.find(std::string(replicates) == "1"
+                             ? "the samples' variance over their number"
+                             : "independent replicate means") != std::string::npos);
     }
 }
 
@@ -645,7 +693,8 @@ TEST_CASE("every environment variable mcrt reads is read through one table and d
     };
     // The table is in enum order, one row per variable.
     REQUIRE(mcrt::kEnvironment.size() == size_t(mcrt::kEnvironmentVariableCount));
-    for (size_t i = 0; i < mcrt::kEnvironment.size(); ++i) CHECK(size_t(mcrt::kEnvironment[i].id) == i);
+    for (size_t i = 0; i < mcrt::kEnvironment.size(); ++i)
+        CHECK(size_t(mcrt::kEnvironment[i].id) == i);
     // No source file reads the environment but common/environment.cpp.
     for (const auto& entry : fs::recursive_directory_iterator(root / "host")) {
         if (!entry.is_regular_file() || entry.path().filename() == "environment.cpp") continue;
@@ -684,7 +733,8 @@ TEST_CASE("an empty value is refused for every option of every subcommand", "[cl
             Sandbox box;
             std::vector<std::string> args = {command};
             if (command != "integrate") args.push_back(option == "scene" ? "" : kCornell);
-            if (command == "render" && option != "--out") args = concat(args, {"--out", box.out("x.exr")});
+            if (command == "render" && option != "--out")
+                args = concat(args, {"--out", box.out("x.exr")});
             if (option != "scene") args = concat(args, {option, ""});
             ProcessResult r = box.run(args, 60);
             INFO(describe(args) << "\n  stderr: " << r.err);
@@ -703,13 +753,16 @@ TEST_CASE("non-finite samples are counted, warned about, and an image of nothing
         const std::string path = (box.tmp.path() / name).string();
         std::ofstream(path) << "float3 estimate(const SceneView* scene, const SurfacePoint* sp, "
                                "const SampleStream* stream, uint* rays) {\n"
-                               "    return " << value << ";\n}\n";
+                               "    return "
+                            << value << ";\n}\n";
         return path;
     };
-    const std::vector<std::string> size = {"--width", "16", "--height", "12", "--spp", "16", "--quiet"};
+    const std::vector<std::string> size = {"--width", "16", "--height", "12",
+                                           "--spp",   "16", "--quiet"};
     SECTION("some samples: one warning with their count and share, the count in the stats") {
         // Infinite on the surfaces facing +x (the left wall), NaN nowhere else.
-        const std::string file = estimator("some.cl", "sp->n.x > 0.5f ? (float3)(1.0f / 0.0f) : (float3)(0.5f)");
+        const std::string file =
+            estimator("some.cl", "sp->n.x > 0.5f ? (float3)(1.0f / 0.0f) : (float3)(0.5f)");
         ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("a.exr"), "--stats",
                                           box.out("a.json"), "--estimator-file", file},
                                          size));
@@ -722,15 +775,16 @@ TEST_CASE("non-finite samples are counted, warned about, and an image of nothing
         CHECK(bad < 16 * 12 * 16);
         char share[16];
         std::snprintf(share, sizeof share, "%.1f%%", 100.0 * double(bad) / (16 * 12 * 16));
-        CHECK(warnings[0] == "mcrt: warning: " + std::to_string(bad) + " of 3072 samples (" + share +
+        CHECK(warnings[0] == "mcrt: warning: " + std::to_string(bad) + " of 3072 samples (" +
+                                 share +
                                  ") were not finite (NaN or infinite) and were counted as 0");
         CHECK(all_finite(read_exr(box.out("a.exr")).rgb));
     }
     SECTION("no non-finite sample: no warning") {
-        ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("a.exr"), "--stats",
-                                          box.out("a.json"), "--estimator-file",
-                                          estimator("fine.cl", "(float3)(0.5f)")},
-                                         size));
+        ProcessResult r = box.run(
+            concat({"render", kCornell, "--out", box.out("a.exr"), "--stats", box.out("a.json"),
+                    "--estimator-file", estimator("fine.cl", "(float3)(0.5f)")},
+                   size));
         REQUIRE(r.exit_code == 0);
         CHECK(lines_starting_with(r.err, "mcrt: warning:").empty());
         CHECK(nlohmann::json::parse(read_whole_file(box.out("a.json")))["nan_samples"] == 0);
@@ -738,11 +792,11 @@ TEST_CASE("non-finite samples are counted, warned about, and an image of nothing
     SECTION("every sample: exit 1, one error line, nothing written") {
         // Inside the box looking at the back wall: every camera ray meets a surface.
         for (const std::string value : {"(float3)(NAN)", "(float3)(1.0f / 0.0f)"}) {
-            ProcessResult r = box.run(concat({"render", kCornell, "--out", box.out("a.exr"), "--png",
-                                              box.out("a.png"), "--stats", box.out("a.json"),
-                                              "--estimator-file", estimator("all.cl", value),
-                                              "--look-from", "0,1,0", "--look-at", "0,1,-1", "--fov", "40"},
-                                             size));
+            ProcessResult r = box.run(concat(
+                {"render", kCornell, "--out", box.out("a.exr"), "--png", box.out("a.png"),
+                 "--stats", box.out("a.json"), "--estimator-file", estimator("all.cl", value),
+                 "--look-from", "0,1,0", "--look-at", "0,1,-1", "--fov", "40"},
+                size));
             INFO(value << ": " << r.err);
             CHECK(r.exit_code == 1);
             CHECK(lines_starting_with(r.err, "mcrt: error:").size() == 1);

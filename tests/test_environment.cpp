@@ -1,9 +1,8 @@
 // Environment maps (host/scene/environment_map.h): the mapping, the texel distribution and its pdf
 // twin, estimators of a known irradiance, and hostile files, each one InputError naming the file.
-#include <catch2/catch.hpp>
-
 #include <OpenEXR/ImfHeader.h>
 
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -206,7 +205,8 @@ TEST_CASE("a sun map: environment sampling beats cosine sampling 100x at equal s
         sum_env += f;
         sq_env += f * f;
         const double r = std::sqrt(uniform(rng)), phi = 2 * kPi * uniform(rng);
-        const auto tc = environment_texel(map, {r * std::cos(phi), std::sqrt(1 - r * r), r * std::sin(phi)}, 0.0);
+        const auto tc = environment_texel(
+            map, {r * std::cos(phi), std::sqrt(1 - r * r), r * std::sin(phi)}, 0.0);
         const double g = map.rgb[3 * (size_t(tc[1]) * w + tc[0])] * kPi;
         sum_cos += g;
         sq_cos += g * g;
@@ -245,7 +245,8 @@ TEST_CASE("hostile environment maps: one InputError naming the file", "[environm
     require_refused(write_map_exr("named.png", 1, 1, 1.0f), ".exr or .hdr");
 }
 
-TEST_CASE("make_sky_maps.py writes maps the reader takes, a sun 10^4 times its sky", "[environment]") {
+TEST_CASE("make_sky_maps.py writes maps the reader takes, a sun 10^4 times its sky",
+          "[environment]") {
     const char* python = "/usr/bin/python3";
     if (!std::filesystem::exists(python)) skip_test(std::string(python) + " not found");
     const std::filesystem::path dir = std::filesystem::path(scratch("sky-maps"));

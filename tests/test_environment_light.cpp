@@ -358,9 +358,9 @@ TEST_CASE("an environment map beside punctual lights alone: both are chosen",
     const std::string map = write_map(dir, "dim.exr", 8, 4, [](int, int, int) { return 1e-4f; });
     auto render_mean = [&](const std::vector<std::string>& extra, const std::string& name,
                            double& variance) {
-        std::vector<std::string> args = {"render",      scene,  "--width", "16", "--height",
-                                         "16",          "--spp", "64",     "--estimator",
-                                         "light-area",  "--quiet", "--out", dir / name};
+        std::vector<std::string> args = {"render",  scene,   "--width", "16",          "--height",
+                                         "16",      "--spp", "64",      "--estimator", "light-area",
+                                         "--quiet", "--out", dir / name};
         args.insert(args.end(), extra.begin(), extra.end());
         const ProcessResult r = run_process(MCRT_EXE, args, dir.path());
         INFO(r.err);

@@ -70,12 +70,11 @@ TEST_CASE("an estimator file sees punctual lights through the light strategies: 
     TempDir tmp("mcrt-estimator-file");
     const std::string scene = std::string(MCRT_SCENES) + "/punctual/punctual-lights.gltf";
     for (const char* select : {"power", "tree"}) {
-        std::vector<std::string> common = {scene,   "--width",        "40",   "--height", "32",
-                                           "--spp", "16",             "--seed", "5",
-                                           "--light-select", select,  "--max-depth", "2",
-                                           "--quiet"};
-        std::vector<std::string> builtin = {"render", "--out", tmp / "builtin.exr",
-                                            "--estimator", "light-area"};
+        std::vector<std::string> common = {
+            scene, "--width",        "40",   "--height",    "32", "--spp",  "16", "--seed",
+            "5",   "--light-select", select, "--max-depth", "2",  "--quiet"};
+        std::vector<std::string> builtin = {"render", "--out", tmp / "builtin.exr", "--estimator",
+                                            "light-area"};
         std::vector<std::string> file = {"render", "--out", tmp / "file.exr", "--estimator-file",
                                          kLightArea};
         builtin.insert(builtin.end(), common.begin(), common.end());
@@ -92,8 +91,10 @@ TEST_CASE("an estimator file sees punctual lights through the light strategies: 
     }
 }
 
-TEST_CASE("examples/estimators/bsdf_directions.cl renders bsdf's image bit for bit on glossy and Lambertian surfaces, and under the sky light",
-          "[estimator-file][cli][materials]") {
+TEST_CASE(
+    "examples/estimators/bsdf_directions.cl renders bsdf's image bit for bit on glossy and "
+    "Lambertian surfaces, and under the sky light",
+    "[estimator-file][cli][materials]") {
     TempDir tmp("mcrt-estimator-file");
     const std::string example = std::string(MCRT_EXAMPLES) + "/estimators/bsdf_directions.cl";
     const std::string dielectric = std::string(MCRT_SCENES) + "/glossy/dielectric-plane.gltf";
@@ -113,9 +114,9 @@ TEST_CASE("examples/estimators/bsdf_directions.cl renders bsdf's image bit for b
         const std::string& scene = c.scene;
         const char* materials = c.materials;
         {
-            std::vector<std::string> common = {scene, "--width", "32", "--height", "32", "--spp",
-                                               "32", "--seed", "3", "--sampler", "sobol",
-                                               "--materials", materials, "--quiet"};
+            std::vector<std::string> common = {
+                scene,    "--width", "32",        "--height", "32",          "--spp",   "32",
+                "--seed", "3",       "--sampler", "sobol",    "--materials", materials, "--quiet"};
             if (std::string(c.sky) != "0") common.insert(common.end(), {"--sky", c.sky});
             std::vector<std::string> builtin = {"render", "--out", tmp / "builtin.exr",
                                                 "--estimator", "bsdf"};
@@ -141,9 +142,9 @@ TEST_CASE("an estimator file is called at every vertex of a path: light-area's i
     // light strategy samples the sky as the built-in's does, at every vertex with its numbers.
     TempDir tmp("mcrt-estimator-file-paths");
     for (const char* sampler : {"independent", "sobol"}) {
-        std::vector<std::string> common = {kCornell, "--width", "32", "--height", "24", "--spp", "32",
-                                           "--sampler", sampler, "--max-depth", "6", "--rr-depth", "2",
-                                           "--sky", "0.3", "--quiet"};
+        std::vector<std::string> common = {
+            kCornell, "--width",     "32", "--height",   "24", "--spp", "32",  "--sampler",
+            sampler,  "--max-depth", "6",  "--rr-depth", "2",  "--sky", "0.3", "--quiet"};
         std::vector<std::string> builtin = {"render", "--out", tmp / "builtin.exr", "--estimator",
                                             "light-area"};
         std::vector<std::string> file = {"render", "--out", tmp / "file.exr", "--estimator-file",
@@ -286,7 +287,8 @@ const std::string kEstimateBody =
 // `mcrt render` of the Cornell box with the estimator file `text`: exit 2 and exactly one
 // `mcrt: error:` line, which names FILE:LINE (or FILE alone when line is 0) and says `says`;
 // nothing written. Returns that line.
-std::string refused(const TempDir& tmp, const std::string& text, int line, const std::string& says) {
+std::string refused(const TempDir& tmp, const std::string& text, int line,
+                    const std::string& says) {
     const std::string file = tmp / "user.cl";
     std::ofstream(file, std::ios::binary) << text;
     const std::string out = tmp / "x.exr";
@@ -330,9 +332,10 @@ TEST_CASE("includes in comments and inactive regions are ignored and the file re
                         << kEstimateBody;
     const std::string plain = tmp / "plain.cl";
     std::ofstream(plain) << kEstimateBody;
-    std::vector<std::string> common = {kCornell, "--width", "8", "--height", "8", "--spp", "4",
-                                       "--quiet", "--estimator-file"};
-    std::vector<std::string> a = {"render", "--out", tmp / "a.exr"}, b = {"render", "--out", tmp / "b.exr"};
+    std::vector<std::string> common = {kCornell, "--width", "8",       "--height",        "8",
+                                       "--spp",  "4",       "--quiet", "--estimator-file"};
+    std::vector<std::string> a = {"render", "--out", tmp / "a.exr"},
+                             b = {"render", "--out", tmp / "b.exr"};
     a.insert(a.end(), common.begin(), common.end());
     b.insert(b.end(), common.begin(), common.end());
     a.push_back(file);
@@ -354,12 +357,15 @@ TEST_CASE("hostile estimator files are refused with one line naming the file's l
             "defines the kernel 'render'");
     refused(tmp, "float g(int n) {\n    return n > 0 ? g(n - 1) : 0.0f;\n}\n" + kEstimateBody, 2,
             "'g' calls itself: OpenCL C forbids recursion");
-    refused(tmp, "float h(int n);\nfloat g(int n) { return h(n); }\n"
-                 "float h(int n) { return n > 0 ? g(n - 1) : 0.0f; }\n" + kEstimateBody,
+    refused(tmp,
+            "float h(int n);\nfloat g(int n) { return h(n); }\n"
+            "float h(int n) { return n > 0 ? g(n - 1) : 0.0f; }\n" +
+                kEstimateBody,
             2, "'g' calls itself (through h)");
-    refused(tmp, "float3 estimate(const SceneView* scene, const SurfacePoint* sp,\n"
-                 "                const SampleStream* stream, uint* rays) {\n"
-                 "    float big[4194304];\n    big[*rays] = 1.0f;\n    return (float3)(big[3]);\n}\n",
+    refused(tmp,
+            "float3 estimate(const SceneView* scene, const SurfacePoint* sp,\n"
+            "                const SampleStream* stream, uint* rays) {\n"
+            "    float big[4194304];\n    big[*rays] = 1.0f;\n    return (float3)(big[3]);\n}\n",
             3, "private arrays of 16777216 bytes");
 }
 

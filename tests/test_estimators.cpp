@@ -3,7 +3,6 @@
 // ambient light next to a wall (the wall's projected solid angle). Standard errors come from
 // independent renders, so they hold for stratified and Sobol samplers too.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "analytic_scenes.h"
@@ -205,7 +204,8 @@ TEST_CASE("the variance layer predicts the spread of renders for every estimator
     uint32_t floor = add_material(ambient, glm::vec3(0.5f));
     add_quad(ambient, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, floor);
     add_quad(ambient, {0, 0, -1.5}, {0, 1, -1.5}, {0, 1, 1.5}, {0, 0, 1.5}, floor);
-    GpuSceneData wall = gpu_scene_for(ambient, looking_down(glm::vec3(0.7f, 3.0f, 0.0f), 0.6f), settings);
+    GpuSceneData wall =
+        gpu_scene_for(ambient, looking_down(glm::vec3(0.7f, 3.0f, 0.0f), 0.6f), settings);
     for (const EstimatorCase& v : estimator_cases(0))
         for (const std::string& sampler : variant_names(kSamplerVariants)) {
             v.apply(settings);
@@ -214,8 +214,8 @@ TEST_CASE("the variance layer predicts the spread of renders for every estimator
             Renders r = independent_renders(device, v.uses(kUsesSky) ? wall : plane, settings, 16,
                                             kFirstSeed);
             INFO(v.label() << " / " << sampler << ", " << settings.replicates
-                           << " replicate(s): layer " << r.pixel_variance_layer
-                           << ", observed " << r.pixel_variance_observed);
+                           << " replicate(s): layer " << r.pixel_variance_layer << ", observed "
+                           << r.pixel_variance_observed);
             REQUIRE(r.pixel_variance_observed > 0);
             CHECK(r.pixel_variance_layer == Approx(r.pixel_variance_observed).epsilon(0.35));
             CHECK(r.non_finite_pixels == 0);

@@ -176,8 +176,8 @@ std::vector<Out> run_both_builds(TestDevice& d, const char* kernel, const std::v
     cl::Buffer in = d.optimised.input(inputs);
     std::vector<Out> v = d.optimised.run<Out>(kernel, inputs.size(), 1, in);
     cl::Buffer in2 = d.unoptimised.input(inputs);
-    CHECK(mismatches(v, d.unoptimised.run<Out>(kernel, inputs.size(), 1, in2),
-                     "-cl-opt-disable") == 0);
+    CHECK(mismatches(v, d.unoptimised.run<Out>(kernel, inputs.size(), 1, in2), "-cl-opt-disable") ==
+          0);
     return v;
 }
 

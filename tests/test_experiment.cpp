@@ -1,10 +1,9 @@
-// The experiment harness (scripts/experiments/experiment.py) in its quick mode, end to end: on the Cornell
-// box (one small light) it writes results.csv with a row per (configuration, spp), the four
+// The experiment harness (scripts/experiments/experiment.py) in its quick mode, end to end: on the
+// Cornell box (one small light) it writes results.csv with a row per (configuration, spp), the four
 // charts, and ranks light-area above hemisphere-cosine in efficiency, while the error of every
 // configuration falls as spp grows. Skipped when Debian's python3 with numpy and matplotlib is
 // missing.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -23,13 +22,16 @@ namespace {
 const char* kPython = "/usr/bin/python3";
 
 std::string script_path() {
-    return (std::filesystem::path(MCRT_SCENES).parent_path() / "scripts" / "experiments" / "experiment.py").string();
+    return (std::filesystem::path(MCRT_SCENES).parent_path() / "scripts" / "experiments" /
+            "experiment.py")
+        .string();
 }
 
 void require_python_modules(const std::filesystem::path& scratch) {
     if (!std::filesystem::exists(kPython)) skip_test(std::string(kPython) + " not found");
     ProcessResult probe = run_process(kPython, {"-c", "import numpy, matplotlib"}, scratch, 60.0);
-    if (probe.exit_code != 0) skip_test("python3 lacks numpy or matplotlib: " + first_line(probe.err));
+    if (probe.exit_code != 0)
+        skip_test("python3 lacks numpy or matplotlib: " + first_line(probe.err));
 }
 
 std::vector<std::string> split(const std::string& line, char separator) {
@@ -65,12 +67,13 @@ TEST_CASE("experiment harness, quick mode: CSV, charts, light-area beats hemisph
     require_python_modules(scratch.path());
 
     std::string out = scratch / "out";
-    ProcessResult run = run_process(
-        kPython,
-        {script_path(), std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf", "--estimators",
-         "light-area,hemisphere-cosine", "--spp", "4,16,64", "--quick", "--reference", "auto",
-         "--reference-cache", scratch / "references", "--mcrt", MCRT_EXE, "--out", out},
-        scratch.path(), 180.0);
+    ProcessResult run =
+        run_process(kPython,
+                    {script_path(), std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf",
+                     "--estimators", "light-area,hemisphere-cosine", "--spp", "4,16,64", "--quick",
+                     "--reference", "auto", "--reference-cache", scratch / "references", "--mcrt",
+                     MCRT_EXE, "--out", out},
+                    scratch.path(), 180.0);
     INFO("stderr: " << run.err);
     REQUIRE_FALSE(run.timed_out);
     REQUIRE(run.exit_code == 0);
@@ -79,12 +82,14 @@ TEST_CASE("experiment harness, quick mode: CSV, charts, light-area beats hemisph
     // The CSV: the required columns, one row per estimator × spp.
     auto rows = read_csv(out + "/results.csv");
     REQUIRE(rows.size() == 6);
-    for (const char* column : {"estimator", "light_select", "sampler", "spp", "seconds", "rmse", "relmse",
-                               "efficiency", "wall_seconds", "repeat", "reference_rmse_floor"})
+    for (const char* column :
+         {"estimator", "light_select", "sampler", "spp", "seconds", "rmse", "relmse", "efficiency",
+          "wall_seconds", "repeat", "reference_rmse_floor"})
         REQUIRE(rows[0].count(column) == 1);
 
     // The charts exist and are PNGs.
-    for (const char* chart : {"error_vs_time.png", "error_vs_spp.png", "efficiency.png", "equal_time.png"}) {
+    for (const char* chart :
+         {"error_vs_time.png", "error_vs_spp.png", "efficiency.png", "equal_time.png"}) {
         std::string path = out + "/" + chart;
         INFO(path);
         REQUIRE(std::filesystem::exists(path));
@@ -101,10 +106,11 @@ TEST_CASE("experiment harness, quick mode: CSV, charts, light-area beats hemisph
     // RMSE ÷2 expected; the reference's own floor is far below).
     std::map<std::string, std::map<int, std::map<std::string, double>>> by_config;
     for (auto& r : rows)
-        by_config[r["estimator"]][std::stoi(r["spp"])] = {{"rmse", std::stod(r["rmse"])},
-                                                         {"relmse", std::stod(r["relmse"])},
-                                                         {"efficiency", std::stod(r["efficiency"])},
-                                                         {"floor", std::stod(r["reference_rmse_floor"])}};
+        by_config[r["estimator"]][std::stoi(r["spp"])] = {
+            {"rmse", std::stod(r["rmse"])},
+            {"relmse", std::stod(r["relmse"])},
+            {"efficiency", std::stod(r["efficiency"])},
+            {"floor", std::stod(r["reference_rmse_floor"])}};
     REQUIRE(by_config.size() == 2);
     for (auto& [estimator, levels] : by_config) {
         INFO(estimator);

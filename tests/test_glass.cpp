@@ -2,7 +2,6 @@
 // what the importer reads and refuses, the F0 the index of refraction gives every dielectric,
 // and scenes without these extensions unchanged.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -59,8 +58,9 @@ Loaded load_material(const std::string& extensions) {
     const std::string text = triangle_gltf(
         R"({"pbrMetallicRoughness": {"metallicFactor": 0}, "extensions": {)" + extensions + "}}");
     Loaded l;
-    Scene s = load_gltf_from_memory("glass.gltf", std::vector<unsigned char>(text.begin(), text.end()),
-                                    [&](const std::string& w) { l.warnings.push_back(w); });
+    Scene s =
+        load_gltf_from_memory("glass.gltf", std::vector<unsigned char>(text.begin(), text.end()),
+                              [&](const std::string& w) { l.warnings.push_back(w); });
     l.material = s.materials.at(0);
     return l;
 }
@@ -118,7 +118,8 @@ TEST_CASE("KHR_materials_ior sets every dielectric's F0; ior 1.5 gives exactly 0
     SECTION("below 1 (not 0): the default with one warning; huge: clamped with one warning") {
         for (const char* bad : {"-2", "0.5", "1e-30"}) {
             INFO(bad);
-            const Loaded l = load_material(std::string(R"("KHR_materials_ior": {"ior": )") + bad + "}");
+            const Loaded l =
+                load_material(std::string(R"("KHR_materials_ior": {"ior": )") + bad + "}");
             REQUIRE(l.warnings.size() == 1);
             CHECK(l.warnings[0].find("KHR_materials_ior.ior") != std::string::npos);
             CHECK(l.material.ior == 1.5f);
@@ -135,7 +136,8 @@ TEST_CASE("KHR_materials_ior sets every dielectric's F0; ior 1.5 gives exactly 0
         CHECK(refusal(R"("KHR_materials_ior": {"ior": 1e999})") != "(loaded)");
         for (const char* bad : {"\"glass\"", "[1.5]", "true"}) {
             INFO(bad);
-            const std::string e = refusal(std::string(R"("KHR_materials_ior": {"ior": )") + bad + "}");
+            const std::string e =
+                refusal(std::string(R"("KHR_materials_ior": {"ior": )") + bad + "}");
             CHECK(e.find("material 0") != std::string::npos);
             CHECK(e.find("KHR_materials_ior.ior must be a finite number") != std::string::npos);
         }
@@ -147,7 +149,8 @@ TEST_CASE("KHR_materials_ior sets every dielectric's F0; ior 1.5 gives exactly 0
 TEST_CASE("transmission and volume are read; bad values warn once with a fallback or are refused",
           "[glass][gltf]") {
     SECTION("transmission alone: thin-walled, not Lambertian, built with -D MCRT_TRANSMISSION") {
-        const Loaded l = load_material(R"("KHR_materials_transmission": {"transmissionFactor": 0.75})");
+        const Loaded l =
+            load_material(R"("KHR_materials_transmission": {"transmissionFactor": 0.75})");
         CHECK(l.warnings.empty());
         CHECK(l.material.transmission == 0.75f);
         CHECK_FALSE(l.material.volume);
@@ -200,14 +203,18 @@ TEST_CASE("transmission and volume are read; bad values warn once with a fallbac
         CHECK(g.attenuation.x == Approx(0.5f));
     }
     SECTION("a volume without transmission, or of thickness 0, is no volume") {
-        CHECK_FALSE(load_material(R"("KHR_materials_volume": {"thicknessFactor": 1})").material.volume);
+        CHECK_FALSE(
+            load_material(R"("KHR_materials_volume": {"thicknessFactor": 1})").material.volume);
         CHECK_FALSE(load_material(R"("KHR_materials_transmission": {"transmissionFactor": 1},
-            "KHR_materials_volume": {"thicknessFactor": 0})").material.volume);
+            "KHR_materials_volume": {"thicknessFactor": 0})")
+                        .material.volume);
     }
     SECTION("attenuationDistance <= 0: no attenuation, one warning; colour clamped; black finite") {
         for (const char* d : {"0", "-3"}) {
-            const Loaded l = load_material(std::string(R"("KHR_materials_transmission": {"transmissionFactor": 1},
-                "KHR_materials_volume": {"thicknessFactor": 1, "attenuationDistance": )") + d + "}");
+            const Loaded l = load_material(
+                std::string(R"("KHR_materials_transmission": {"transmissionFactor": 1},
+                "KHR_materials_volume": {"thicknessFactor": 1, "attenuationDistance": )") +
+                d + "}");
             REQUIRE(l.warnings.size() == 2);  // and the open surface's
             CHECK(l.warnings[0].find("attenuationDistance") != std::string::npos);
             CHECK(volume_attenuation(l.material) == glm::dvec3(0.0));
@@ -233,14 +240,22 @@ TEST_CASE("transmission and volume are read; bad values warn once with a fallbac
     }
     SECTION("transmissionTexture: its index is checked, a texture without image is warned about") {
         // The triangle's file has no textures: index 0 names nothing.
-        CHECK(refusal(R"("KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": {"index": 0}})")
-                  .find("texture") != std::string::npos);
-        CHECK(refusal(R"("KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": {"index": 4294967296}})")
-                  .find("transmissionTexture.index") != std::string::npos);
-        CHECK(refusal(R"("KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": {"texCoord": 0}})")
-                  .find("transmissionTexture.index: required") != std::string::npos);
-        CHECK(refusal(R"("KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": 3})")
-                  .find("transmissionTexture") != std::string::npos);
+        CHECK(
+            refusal(
+                R"("KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": {"index": 0}})")
+                .find("texture") != std::string::npos);
+        CHECK(
+            refusal(
+                R"("KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": {"index": 4294967296}})")
+                .find("transmissionTexture.index") != std::string::npos);
+        CHECK(
+            refusal(
+                R"("KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": {"texCoord": 0}})")
+                .find("transmissionTexture.index: required") != std::string::npos);
+        CHECK(
+            refusal(
+                R"("KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": 3})")
+                .find("transmissionTexture") != std::string::npos);
     }
     SECTION("refused: non-numbers, a negative thickness, a malformed colour") {
         CHECK(refusal(R"("KHR_materials_transmission": {"transmissionFactor": "all"})")
@@ -294,8 +309,9 @@ struct Glass {
 };
 
 KernelProgram& glass_device() {
-    static KernelProgram d("bsdf_test.cl", "-D MCRT_MATERIALS_GLTF -D MCRT_TRANSMISSION "
-                                           "-D LIGHT_SELECT_POWER -D SAMPLER_INDEPENDENT");
+    static KernelProgram d("bsdf_test.cl",
+                           "-D MCRT_MATERIALS_GLTF -D MCRT_TRANSMISSION "
+                           "-D LIGHT_SELECT_POWER -D SAMPLER_INDEPENDENT");
     return d;
 }
 
@@ -318,7 +334,8 @@ struct GlassSamples {
 
 GlassSamples sample_glass(const Glass& g, dvec3 wo, size_t n, cl_uint seed) {
     KernelProgram& d = glass_device();
-    cl::Buffer out = d.output<cl_float4>(n), f = d.output<cl_float4>(n), lobe = d.output<cl_uint>(n);
+    cl::Buffer out = d.output<cl_float4>(n), f = d.output<cl_float4>(n),
+               lobe = d.output<cl_uint>(n);
     d.run("glass_samples", n, g.packed(), f4(wo), cl_uint(g.front), cl_uint(n), seed, out, f, lobe);
     return {d.read<cl_float4>(out, n), d.read<cl_float4>(f, n), d.read<cl_uint>(lobe, n)};
 }
@@ -326,7 +343,8 @@ GlassSamples sample_glass(const Glass& g, dvec3 wo, size_t n, cl_uint seed) {
 void evaluate_glass(const Glass& g, dvec3 wo, const std::vector<cl_float4>& wi,
                     std::vector<float>* pdf, std::vector<cl_float4>* f) {
     KernelProgram& d = glass_device();
-    cl::Buffer in = d.buffer(wi), p = d.output<float>(wi.size()), fb = d.output<cl_float4>(wi.size());
+    cl::Buffer in = d.buffer(wi), p = d.output<float>(wi.size()),
+               fb = d.output<cl_float4>(wi.size());
     d.run("glass_evaluate", wi.size(), g.packed(), f4(wo), cl_uint(g.front), cl_uint(wi.size()), in,
           p, fb);
     if (pdf) *pdf = d.read<float>(p, wi.size());
@@ -402,7 +420,8 @@ void glass_chi2(const Glass& glass, double view_degrees, cl_uint seed) {
         if (!(wi[k].s[3] > 0)) continue;
         bool same = std::abs(pdf[k] - wi[k].s[3]) <= 1e-4 * wi[k].s[3];
         for (int c = 0; c < 3; ++c)
-            same = same && std::abs(f[k].s[c] - s.f_cos[k].s[c]) <= 1e-4 * std::abs(s.f_cos[k].s[c]);
+            same =
+                same && std::abs(f[k].s[c] - s.f_cos[k].s[c]) <= 1e-4 * std::abs(s.f_cos[k].s[c]);
         mismatched += same ? 0 : 1;
     }
     CHECK(mismatched == 0);
@@ -538,7 +557,8 @@ TEST_CASE("rough glass loses energy only to single scattering, and never more th
                     sum += v;
                     sum2 += v * v;
                 }
-                const double mean = sum / n, se = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
+                const double mean = sum / n,
+                             se = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
                 INFO((volume ? "volume" : "thin") << " roughness " << roughness << " view " << view
                                                   << ": albedo " << mean << " +- " << se);
                 CHECK(mean <= 1.0 + 4.5 * se);
@@ -566,16 +586,18 @@ TEST_CASE("the exact Fresnel term and exp2 agree with double precision", "[glass
         for (size_t k = 0; k < in.size(); ++k) {
             const double x = in[k].s[0], e = std::exp2(x);
             if (e > 1e-37) worst_exp = std::max(worst_exp, std::abs(v[k].s[0] - e) / e);
-            worst_fresnel =
-                std::max(worst_fresnel, std::abs(v[k].s[1] - fresnel_reference(in[k].s[1], float(eta))));
+            worst_fresnel = std::max(
+                worst_fresnel, std::abs(v[k].s[1] - fresnel_reference(in[k].s[1], float(eta))));
         }
-        INFO("eta " << eta << ": exp2 relative error " << worst_exp << ", Fresnel " << worst_fresnel);
-        CHECK(worst_exp < 2.5e-7);     // 2 ulp
+        INFO("eta " << eta << ": exp2 relative error " << worst_exp << ", Fresnel "
+                    << worst_fresnel);
+        CHECK(worst_exp < 2.5e-7);  // 2 ulp
         CHECK(worst_fresnel < 1e-5);
     }
 }
 
-// ---- The white furnace: a glass sphere under a uniform sky ---------------------------------------
+// ---- The white furnace: a glass sphere under a uniform sky
+// ---------------------------------------
 
 namespace {
 
@@ -609,7 +631,8 @@ FurnaceCheck furnace_check(const RenderResult& r) {
         var += s2;
         if (s2 > 0) {
             // 1e-6: the float rounding of an average of 1s (ior 1 passes light unchanged).
-            c.worst_z = std::max(c.worst_z, std::max(0.0, std::abs(v - 1.0) - 1e-6) / std::sqrt(s2));
+            c.worst_z =
+                std::max(c.worst_z, std::max(0.0, std::abs(v - 1.0) - 1e-6) / std::sqrt(s2));
             ++c.glass_pixels;
         } else {
             ++c.exact_pixels;
@@ -649,33 +672,33 @@ TEST_CASE("white furnace: a smooth glass sphere under a sky of radiance 1 render
     DeviceContext device = first_device();
     for (bool volume : {false, true})
         for (uint32_t rr_depth : {3u, MCRT_MAX_PATH_DEPTH})
-        for (const char* estimator : {"mis", "bsdf", "light-area"}) {
-            Glass glass = rough(0.0, volume, true, "furnace");
-            GlassFurnace f(glass);
-            RenderSettings settings = furnace_settings(estimator);
-            settings.rr_depth = rr_depth;
-            GpuSceneData data = gpu_scene_for(f.scene, f.camera, settings);
-            REQUIRE(data.transmission);
-            REQUIRE(make_render_plan(settings, data).program_options.find("-D MCRT_TRANSMISSION") !=
+            for (const char* estimator : {"mis", "bsdf", "light-area"}) {
+                Glass glass = rough(0.0, volume, true, "furnace");
+                GlassFurnace f(glass);
+                RenderSettings settings = furnace_settings(estimator);
+                settings.rr_depth = rr_depth;
+                GpuSceneData data = gpu_scene_for(f.scene, f.camera, settings);
+                REQUIRE(data.transmission);
+                REQUIRE(
+                    make_render_plan(settings, data).program_options.find("-D MCRT_TRANSMISSION") !=
                     std::string::npos);
-            const FurnaceCheck c = furnace_check(render(device, data, settings));
-            INFO((volume ? "volume" : "thin-walled") << ", " << estimator << ", roulette from "
-                                                    << rr_depth << ": mean " << c.mean
-                                                    << " +- " << c.mean_se << ", worst |z| "
-                                                    << c.worst_z << " over " << c.glass_pixels
-                                                    << " pixel channels");
-            CHECK(c.nan_samples == 0);
-            CHECK(c.glass_pixels > 300);  // most of the 432 pixel channels see the glass
-            CHECK(c.wrong_exact == 0);
-            // 144 pixels (their channels alike): |z| < 4.5 for each holds with 99.9% for normal
-            // means.
-            CHECK(c.worst_z < 4.5);
-            CHECK(std::abs(c.mean - 1.0) < 4.5 * c.mean_se + 1e-6);
-            // Not vacuous. Inside a volume, roulette meets paths of hundreds of reflections:
-            // their survivors' weights 1/0.95^k make its spread large. Without roulette every
-            // sample is 1 to rounding.
-            CHECK(c.mean_se < (rr_depth == MCRT_MAX_PATH_DEPTH ? 1e-6 : volume ? 1e-2 : 1e-4));
-        }
+                const FurnaceCheck c = furnace_check(render(device, data, settings));
+                INFO((volume ? "volume" : "thin-walled")
+                     << ", " << estimator << ", roulette from " << rr_depth << ": mean " << c.mean
+                     << " +- " << c.mean_se << ", worst |z| " << c.worst_z << " over "
+                     << c.glass_pixels << " pixel channels");
+                CHECK(c.nan_samples == 0);
+                CHECK(c.glass_pixels > 300);  // most of the 432 pixel channels see the glass
+                CHECK(c.wrong_exact == 0);
+                // 144 pixels (their channels alike): |z| < 4.5 for each holds with 99.9% for normal
+                // means.
+                CHECK(c.worst_z < 4.5);
+                CHECK(std::abs(c.mean - 1.0) < 4.5 * c.mean_se + 1e-6);
+                // Not vacuous. Inside a volume, roulette meets paths of hundreds of reflections:
+                // their survivors' weights 1/0.95^k make its spread large. Without roulette every
+                // sample is 1 to rounding.
+                CHECK(c.mean_se < (rr_depth == MCRT_MAX_PATH_DEPTH ? 1e-6 : volume ? 1e-2 : 1e-4));
+            }
 }
 
 TEST_CASE("the furnace sees a tinted or absorbing glass sphere: the check can fail",
@@ -691,15 +714,18 @@ TEST_CASE("the furnace sees a tinted or absorbing glass sphere: the check can fa
             f.scene.materials[0].attenuation_distance = 1.0f;
         }
         RenderSettings settings = furnace_settings("mis");
-        const FurnaceCheck c = furnace_check(render(device, gpu_scene_for(f.scene, f.camera, settings), settings));
-        INFO(glass.label << ": mean " << c.mean << " +- " << c.mean_se << ", worst |z| " << c.worst_z);
+        const FurnaceCheck c =
+            furnace_check(render(device, gpu_scene_for(f.scene, f.camera, settings), settings));
+        INFO(glass.label << ": mean " << c.mean << " +- " << c.mean_se << ", worst |z| "
+                         << c.worst_z);
         CHECK(c.nan_samples == 0);
         CHECK(c.mean < 1.0 - 10.0 * c.mean_se);
         CHECK(c.worst_z > 4.5);
     }
 }
 
-// ---- Estimators agree where glass is in the light's way ------------------------------------------
+// ---- Estimators agree where glass is in the light's way
+// ------------------------------------------
 
 TEST_CASE("every path estimator renders the same mean through rough and smooth glass",
           "[glass][estimators]") {
@@ -740,9 +766,9 @@ TEST_CASE("every path estimator renders the same mean through rough and smooth g
         for (const auto& [name, r] : results) {
             INFO("roughness " << roughness << ", " << name << ": (" << r.mean.x << ", " << r.mean.y
                               << ", " << r.mean.z << ") +- (" << r.standard_error.x << ", "
-                              << r.standard_error.y << ", " << r.standard_error.z << ") against mis ("
-                              << reference.mean.x << ", " << reference.mean.y << ", "
-                              << reference.mean.z << ")");
+                              << r.standard_error.y << ", " << r.standard_error.z
+                              << ") against mis (" << reference.mean.x << ", " << reference.mean.y
+                              << ", " << reference.mean.z << ")");
             CHECK(r.nan_samples == 0);
             CHECK(r.non_finite_pixels == 0);
             for (int c = 0; c < 3; ++c) {
@@ -790,11 +816,11 @@ TEST_CASE("a smooth glass slab over a Lambertian floor under the sky: the floor'
     const uint32_t glass = uint32_t(scene.materials.size() - 1);
     const float y0 = 0.5f, y1 = 0.6f;
     // The box's six faces, counter-clockwise seen from outside.
-    add_quad(scene, {-w, y1, -w}, {-w, y1, w}, {w, y1, w}, {w, y1, -w}, glass);  // top, +y
-    add_quad(scene, {-w, y0, -w}, {w, y0, -w}, {w, y0, w}, {-w, y0, w}, glass);  // bottom, −y
-    add_quad(scene, {-w, y0, w}, {w, y0, w}, {w, y1, w}, {-w, y1, w}, glass);    // +z
+    add_quad(scene, {-w, y1, -w}, {-w, y1, w}, {w, y1, w}, {w, y1, -w}, glass);    // top, +y
+    add_quad(scene, {-w, y0, -w}, {w, y0, -w}, {w, y0, w}, {-w, y0, w}, glass);    // bottom, −y
+    add_quad(scene, {-w, y0, w}, {w, y0, w}, {w, y1, w}, {-w, y1, w}, glass);      // +z
     add_quad(scene, {-w, y0, -w}, {-w, y1, -w}, {w, y1, -w}, {w, y0, -w}, glass);  // −z
-    add_quad(scene, {w, y0, -w}, {w, y1, -w}, {w, y1, w}, {w, y0, w}, glass);    // +x
+    add_quad(scene, {w, y0, -w}, {w, y1, -w}, {w, y1, w}, {w, y0, w}, glass);      // +x
     add_quad(scene, {-w, y0, -w}, {-w, y0, w}, {-w, y1, w}, {-w, y1, -w}, glass);  // −x
     Camera camera = looking_down(glm::vec3(0.0f, 0.25f, 0.0f), glm::radians(30.0f));
     DeviceContext device = first_device();
@@ -856,7 +882,8 @@ TEST_CASE("transmissionTexture scales transmissionFactor by its R channel", "[gl
     settings.rr_depth = 16;
     settings.estimator = "mis";
     auto renders = [&](const Scene& scene) {
-        return independent_renders(device, gpu_scene_for(scene, camera, settings), settings, 10, 1300);
+        return independent_renders(device, gpu_scene_for(scene, camera, settings), settings, 10,
+                                   1300);
     };
     auto agree = [](const Renders& a, const Renders& b, const std::string& what) {
         INFO(what << ": (" << a.mean.x << ", " << a.mean.y << ", " << a.mean.z << ") against ("

@@ -144,8 +144,7 @@ TEST_CASE("SimpleSparseAccessor: bounds reflect the sparse override", "[gltf][kh
 }
 
 TEST_CASE("MultipleScenes: only the default scene is imported", "[gltf][khronos]") {
-    const mcrt::Scene scene =
-        load(scene_path("khronos/MultipleScenes/MultipleScenes.gltf")).scene;
+    const mcrt::Scene scene = load(scene_path("khronos/MultipleScenes/MultipleScenes.gltf")).scene;
     // `scene` is 1: its mesh is the unit square (2 triangles); scene 0's single triangle is not
     // imported. Only the square has the corner (1, 1, 0).
     CHECK(scene.triangle_count() == 2);
@@ -170,8 +169,7 @@ TEST_CASE("Cameras: the perspective camera is kept, the orthographic one warned 
 // ---------------------------------------------------------------------------------------------
 
 TEST_CASE("McGuire Cornell box: 36 triangles, one camera, a light facing down", "[gltf][cornell]") {
-    const mcrt::Scene scene =
-        load(scene_path("cornell/CornellBox-Original.gltf")).scene;
+    const mcrt::Scene scene = load(scene_path("cornell/CornellBox-Original.gltf")).scene;
     CHECK(scene.triangle_count() == 36);
     REQUIRE(scene.cameras.size() == 1);
     CHECK(scene.cameras[0].yfov == Approx(glm::radians(39.3f)).epsilon(0.01));

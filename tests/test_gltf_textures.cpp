@@ -3,6 +3,7 @@
 // the images they use (gltf_images.cpp): every PNG colour type and depth, baseline and
 // progressive JPEG, and the refusals (truncated, too large, KTX2 / WebP, out-of-range indices).
 #include <stb/stb_image_write.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <catch2/catch.hpp>
@@ -11,8 +12,6 @@
 #include <fstream>
 #include <string>
 #include <vector>
-
-#include <zlib.h>
 
 #include "common/error.h"
 #include "image/jpeg_structure.h"
@@ -55,7 +54,7 @@ struct TexturedGltf {
     // The attributes of primitive k where given (its entry not empty), else all three.
     std::vector<std::string> attributes;
     std::vector<size_t> material_of;  // primitive k's material where given, else material k
-    Bytes embedded;  // bytes after the geometry, as bufferView 4 (an image's)
+    Bytes embedded;                   // bytes after the geometry, as bufferView 4 (an image's)
 
     std::string text() const {
         Bytes buffer;
@@ -335,8 +334,9 @@ TEST_CASE("texCoord 0 and 1 are read; other sets are refused", "[gltf][textures]
         R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 2}}}])";
     CHECK(contains(refusal(g), "material 0 baseColorTexture: texCoord 2 is not read"));
     g.materials = R"([{"emissiveTexture": {"index": 0, "texCoord": -1}}])";
-    CHECK(contains(refusal(g), "materials[0].emissiveTexture.texCoord: expected an integer from 0 "
-                               "to 2147483647, found -1"));
+    CHECK(contains(refusal(g),
+                   "materials[0].emissiveTexture.texCoord: expected an integer from 0 "
+                   "to 2147483647, found -1"));
 }
 
 TEST_CASE("a texture on a TEXCOORD_n the primitive lacks is ignored there, with one warning",
@@ -369,9 +369,10 @@ TEST_CASE("a texture on a TEXCOORD_n the primitive lacks is ignored there, with 
             g.materials = std::string("[") + slot.material + "]";
             const Loaded l = load(g);
             REQUIRE(l.warnings.size() == 1);
-            CHECK(contains(l.warnings[0], "textured.gltf: mesh 0 primitive 0: lacks the texture "
-                                          "coordinates that material 0 reads for " +
-                                              std::string(slot.slot) + " (TEXCOORD_1); ignored"));
+            CHECK(contains(l.warnings[0],
+                           "textured.gltf: mesh 0 primitive 0: lacks the texture "
+                           "coordinates that material 0 reads for " +
+                               std::string(slot.slot) + " (TEXCOORD_1); ignored"));
             REQUIRE(l.scene.triangle_material.size() == 1);
             const Material& m = l.scene.materials[l.scene.triangle_material[0]];
             CHECK_FALSE((m.*slot.ref).used());
@@ -398,8 +399,9 @@ TEST_CASE("a texture on a TEXCOORD_n the primitive lacks is ignored there, with 
                            "normalTexture": {"index": 0}, "name": "Floor"}])";
         const Loaded l = load(g);
         REQUIRE(l.warnings.size() == 1);
-        CHECK(contains(l.warnings[0], "material 0 (\"Floor\") reads for baseColorTexture "
-                                      "(TEXCOORD_0), normalTexture (TEXCOORD_0); ignored"));
+        CHECK(contains(l.warnings[0],
+                       "material 0 (\"Floor\") reads for baseColorTexture "
+                       "(TEXCOORD_0), normalTexture (TEXCOORD_0); ignored"));
         const Material& m = l.scene.materials[l.scene.triangle_material[0]];
         CHECK_FALSE(m.base_color_texture.used());
         CHECK_FALSE(m.normal_texture.used());
@@ -409,7 +411,8 @@ TEST_CASE("a texture on a TEXCOORD_n the primitive lacks is ignored there, with 
         g.primitives = 3;
         g.material_of = {0, 0, 0};
         g.attributes = {"", R"("POSITION": 0, "TEXCOORD_0": 1)", R"("POSITION": 0)"};
-        g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}}}])";
+        g.materials =
+            R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}}}])";
         const Loaded l = load(g);
         REQUIRE(l.warnings.size() == 1);  // one warning for both primitives
         CHECK(contains(l.warnings[0], "mesh 0 primitive 1: lacks"));
@@ -423,18 +426,22 @@ TEST_CASE("a texture on a TEXCOORD_n the primitive lacks is ignored there, with 
         CHECK(l.scene.images.size() == 1);
     }
     SECTION("instances of one primitive are one primitive in the warning") {
-        g.materials = R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}}}])";
+        g.materials =
+            R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}}}])";
         std::string text = g.text();
         for (const auto& [from, to] :
-             {std::pair<std::string, std::string>{R"("scenes": [{"nodes": [0]}])", R"("scenes": [{"nodes": [0, 1]}])"},
-              {R"("nodes": [{"mesh": 0}])", R"("nodes": [{"mesh": 0}, {"mesh": 0, "translation": [0, 0, 1]}])"}}) {
+             {std::pair<std::string, std::string>{R"("scenes": [{"nodes": [0]}])",
+                                                  R"("scenes": [{"nodes": [0, 1]}])"},
+              {R"("nodes": [{"mesh": 0}])",
+               R"("nodes": [{"mesh": 0}, {"mesh": 0, "translation": [0, 0, 1]}])"}}) {
             const size_t at = text.find(from);
             REQUIRE(at != std::string::npos);
             text.replace(at, from.size(), to);
         }
         std::vector<std::string> warnings;
-        const Scene scene = load_gltf_from_memory("textured.gltf", Bytes(text.begin(), text.end()),
-                                                  [&](const std::string& w) { warnings.push_back(w); });
+        const Scene scene =
+            load_gltf_from_memory("textured.gltf", Bytes(text.begin(), text.end()),
+                                  [&](const std::string& w) { warnings.push_back(w); });
         CHECK(scene.triangle_count() == 2);
         REQUIRE(warnings.size() == 1);
         CHECK_FALSE(contains(warnings[0], "more primitive"));
@@ -561,7 +568,8 @@ TEST_CASE("texture references: out of range refused, a texture without source wa
     g.textures = R"([{"source": 3}])";
     CHECK(contains(refusal(g), "texture 0: source image 3 out of range"));
     g.textures = R"([{"source": "0"}])";
-    CHECK(contains(refusal(g), "textures[0].source: expected an integer from 0 to 2147483647, found a string"));
+    CHECK(contains(refusal(g),
+                   "textures[0].source: expected an integer from 0 to 2147483647, found a string"));
     g.textures = "[{}]";
     const Loaded l = load(g);
     CHECK_FALSE(l.scene.materials[0].base_color_texture.used());
@@ -738,7 +746,8 @@ TEST_CASE("damaged or oversized images are refused with one line naming them",
         // IDAT starts at byte 33, after the signature (8) and IHDR (25).
         Bytes flipped = good;
         flipped[33 + 8 + 2] ^= 0xFF;  // the first stored block's header
-        CHECK(contains(decode({flipped}).error, "image 0: PNG chunk IDAT at byte 33: CRC mismatch"));
+        CHECK(
+            contains(decode({flipped}).error, "image 0: PNG chunk IDAT at byte 33: CRC mismatch"));
         flipped = good;
         flipped[flipped.size() - 20] ^= 0x01;  // a texel's byte in the stored block
         CHECK(contains(decode({flipped}).error, "PNG chunk IDAT at byte 33: CRC mismatch"));
@@ -808,27 +817,34 @@ TEST_CASE("damaged or oversized images are refused with one line naming them",
                 const int p = a + b - c, pa = std::abs(p - a), pb = std::abs(p - b),
                           pc = std::abs(p - c);
                 const int predictor[5] = {0, a, b, (a + b) / 2,
-                                          pa <= pb && pa <= pc ? a : pb <= pc ? b : c};
+                                          pa <= pb && pa <= pc ? a
+                                          : pb <= pc           ? b
+                                                               : c};
                 stored.push_back((unsigned char)(target[i] - predictor[filter]));
             }
-            CHECK(contains(decode({png_with_stream(4, 2, 8, 3, zlib_stored(stored), {palette})}).error,
-                           "image 0: the PNG's texel (2, 1) has palette index 2, beyond its "
-                           "2-colour palette"));
+            CHECK(contains(
+                decode({png_with_stream(4, 2, 8, 3, zlib_stored(stored), {palette})}).error,
+                "image 0: the PNG's texel (2, 1) has palette index 2, beyond its "
+                "2-colour palette"));
         }
         // 2-bit indices, packed: 0 1 3 0 in one byte (0b00011100).
-        CHECK(contains(decode({png_with_stream(4, 1, 2, 3, zlib_stored({0, 0x1C}), {palette})}).error,
-                       "texel (2, 0) has palette index 3"));
+        CHECK(
+            contains(decode({png_with_stream(4, 1, 2, 3, zlib_stored({0, 0x1C}), {palette})}).error,
+                     "texel (2, 0) has palette index 3"));
         // The padding bits of a row's last byte are not texels: 0 1 in the top 4 bits, 3 3 after.
-        CHECK(decode({png_with_stream(2, 1, 2, 3, zlib_stored({0, 0x1F}), {palette})}).error.empty());
+        CHECK(
+            decode({png_with_stream(2, 1, 2, 3, zlib_stored({0, 0x1F}), {palette})}).error.empty());
         // Adam7: 3 × 3 texels in passes 1 (0, 0), 2 none, 3 none, 4 (2, 0), 5 none... per PNG
         // 8.2: pass 1 texel (0,0); pass 4 (2,0); pass 5 (0,2),(2,2); pass 6 (1,0),(1,2); pass 7
         // row 1: (0,1),(1,1),(2,1). Index 2 at (1, 1), in pass 7.
-        const Bytes interlaced = {0, 0,  0, 0,  0, 0, 0,  0, 0,  0, 0,  0, 1, 2, 1};
-        CHECK(contains(decode({png_with_stream(3, 3, 8, 3, zlib_stored(interlaced), {palette}, true)}).error,
-                       "the PNG's texel (1, 1) has palette index 2"));
+        const Bytes interlaced = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 2, 1};
+        CHECK(contains(
+            decode({png_with_stream(3, 3, 8, 3, zlib_stored(interlaced), {palette}, true)}).error,
+            "the PNG's texel (1, 1) has palette index 2"));
         Bytes fine = interlaced;
         fine[13] = 1;
-        const Decoded adam7 = decode({png_with_stream(3, 3, 8, 3, zlib_stored(fine), {palette}, true)});
+        const Decoded adam7 =
+            decode({png_with_stream(3, 3, 8, 3, zlib_stored(fine), {palette}, true)});
         REQUIRE(adam7.error.empty());
         CHECK(adam7.images[0].rgba[4 * 4] == 40);  // texel (1, 1): colour 1
         CHECK(adam7.images[0].rgba[4 * 3] == 40);  // texel (0, 1)
@@ -907,11 +923,13 @@ TEST_CASE("damaged or oversized images are refused with one line naming them",
             unsigned marker, precision;
             const char* why;
         } codings[] = {
-            {0xC1, 12, "the JPEG has 12-bit samples (SOF1), which the decoder mcrt uses (stb_image) "
-                       "reads baseline and progressive Huffman JPEG of 8-bit samples only"},
+            {0xC1, 12,
+             "the JPEG has 12-bit samples (SOF1), which the decoder mcrt uses (stb_image) "
+             "reads baseline and progressive Huffman JPEG of 8-bit samples only"},
             {0xC2, 12, "12-bit samples (SOF2)"},
-            {0xC3, 8, "the JPEG is lossless (SOF3), a coding that the decoder mcrt uses (stb_image) "
-                      "reads baseline and progressive Huffman JPEG of 8-bit samples"},
+            {0xC3, 8,
+             "the JPEG is lossless (SOF3), a coding that the decoder mcrt uses (stb_image) "
+             "reads baseline and progressive Huffman JPEG of 8-bit samples"},
             {0xC5, 8, "hierarchical (differential sequential) (SOF5)"},
             {0xC7, 16, "hierarchical lossless (SOF7)"},
             {0xC9, 8, "arithmetic-coded (extended sequential) (SOF9)"},
@@ -920,7 +938,8 @@ TEST_CASE("damaged or oversized images are refused with one line naming them",
         };
         for (const auto& c : codings) {
             INFO(c.why);
-            const std::string error = decode({with_frame(small, c.marker, c.precision, 8, 8)}).error;
+            const std::string error =
+                decode({with_frame(small, c.marker, c.precision, 8, 8)}).error;
             CHECK(contains(error, "image 0: the JPEG "));
             CHECK(contains(error, c.why));
             CHECK_FALSE(contains(error, "corrupt"));
@@ -977,7 +996,8 @@ TEST_CASE("PNG scanline bytes: Adam7 passes counted texel by texel; JPEG blocks 
                     uint64_t columns = 0, rows = 0;
                     std::vector<uint64_t> per_row(h, 0);
                     for (uint32_t y = 0; y < h; ++y)
-                        for (uint32_t x = 0; x < w; ++x) per_row[y] += pattern[y % 8][x % 8] == pass;
+                        for (uint32_t x = 0; x < w; ++x)
+                            per_row[y] += pattern[y % 8][x % 8] == pass;
                     for (uint32_t y = 0; y < h; ++y) {
                         if (per_row[y] == 0) continue;
                         ++rows;
@@ -993,8 +1013,8 @@ TEST_CASE("PNG scanline bytes: Adam7 passes counted texel by texel; JPEG blocks 
     }
     // JPEG 4:2:0 (Y sampled 2 × 2): a 17 × 9 image is 3 × 2 blocks of Y (its texels) and 2 × 1 of
     // each chroma; padded to whole 16 × 16 MCUs, 32 × 16 samples of Y and 16 × 8 of each chroma.
-    Bytes frame = {0xFF, 0xD8, 0xFF, 0xC0, 0, 17, 8, 0, 9, 0, 17, 3,
-                   1, 0x22, 0, 2, 0x11, 1, 3, 0x11, 1};
+    Bytes frame = {0xFF, 0xD8, 0xFF, 0xC0, 0, 17,   8, 0, 9,    0, 17,
+                   3,    1,    0x22, 0,    2, 0x11, 1, 3, 0x11, 1};
     JpegFrame parsed;
     REQUIRE(read_jpeg_frame(frame.data(), frame.size(), parsed).empty());
     CHECK(parsed.width == 17);
@@ -1004,8 +1024,7 @@ TEST_CASE("PNG scanline bytes: Adam7 passes counted texel by texel; JPEG blocks 
     CHECK(parsed.padded_samples == 32 * 16 + 2 * (16 * 8));
 }
 
-TEST_CASE("the textured sample scenes load with every used image decoded",
-          "[gltf][textures]") {
+TEST_CASE("the textured sample scenes load with every used image decoded", "[gltf][textures]") {
     struct Expected {
         const char* scene;
         size_t images;
@@ -1033,8 +1052,8 @@ TEST_CASE("the textured sample scenes load with every used image decoded",
             CHECK(image.rgba.size() == size_t(4) * image.width * image.height);
     }
     SECTION("TextureEncodingTest: gAMA and iCCP variants of a 1×1 green hold the same texel") {
-        const Scene scene = load_gltf(
-            scene_path("textured/TextureEncodingTest/TextureEncodingTest.gltf"), nullptr);
+        const Scene scene =
+            load_gltf(scene_path("textured/TextureEncodingTest/TextureEncodingTest.gltf"), nullptr);
         size_t one_by_one = 0;
         for (const TextureImage& image : scene.images) one_by_one += image.width == 1;
         CHECK(one_by_one == 6);

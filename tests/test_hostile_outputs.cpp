@@ -1,5 +1,5 @@
-// Outputs that destroy, signals and pipes, images too large (docs/ROBUSTNESS.md, "Hostile input"): no
-// output path is replaced unless it is a regular file that is no other output and no input, no
+// Outputs that destroy, signals and pipes, images too large (docs/ROBUSTNESS.md, "Hostile input"):
+// no output path is replaced unless it is a regular file that is no other output and no input, no
 // temporary file survives any way the process can end, and a closed stderr pipe or a late
 // SIGTERM does not lose the image. The tests never point an output at a system file: FIFOs,
 // directories and devices are made in a temporary directory (mkfifo needs no privilege).
@@ -20,8 +20,8 @@
 #include <thread>
 
 #include "common/atomic_file.h"
-#include "common/output_paths.h"
 #include "common/error.h"
+#include "common/output_paths.h"
 #include "hostile_support.h"
 #include "image/image.h"
 #include "process_support.h"
@@ -37,11 +37,12 @@ namespace {
 const std::string kCornell = std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf";
 
 std::vector<std::string> small_render(const std::string& out) {
-    return {"render", kCornell, "--width", "16", "--height", "12", "--spp", "16", "--quiet",
-            "--out", out};
+    return {"render", kCornell, "--width", "16",    "--height", "12",
+            "--spp",  "16",     "--quiet", "--out", out};
 }
 
-std::vector<std::string> with(std::vector<std::string> args, std::initializer_list<std::string> more) {
+std::vector<std::string> with(std::vector<std::string> args,
+                              std::initializer_list<std::string> more) {
     args.insert(args.end(), more);
     return args;
 }
@@ -49,7 +50,8 @@ std::vector<std::string> with(std::vector<std::string> args, std::initializer_li
 // Every name in `dir`, hidden ones included.
 std::vector<std::string> names_in(const fs::path& dir) {
     std::vector<std::string> names;
-    for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
+    for (const auto& entry : fs::directory_iterator(dir))
+        names.push_back(entry.path().filename().string());
     std::sort(names.begin(), names.end());
     return names;
 }
@@ -98,7 +100,8 @@ TEST_CASE("an existing output that is not a regular file is refused before rende
     for (const std::string option : {"--out", "--png", "--stats"}) {
         for (const std::string& target : {fifo, directory}) {
             DYNAMIC_SECTION(option << " " << fs::path(target).filename().string()) {
-                std::vector<std::string> args = small_render(option == "--out" ? target : dir / "a.exr");
+                std::vector<std::string> args =
+                    small_render(option == "--out" ? target : dir / "a.exr");
                 if (option != "--out") args = with(args, {option, target});
                 const ProcessResult r = run_process(MCRT_EXE, args, logs.path(), 60);
                 require_one_error(r, 2, "refusing to replace it");
@@ -116,7 +119,8 @@ TEST_CASE("write_atomically never replaces what is not a regular file", "[output
     TempDir dir("mcrt-hostile");
     const std::string fifo = dir / "fifo";
     REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
-    CHECK_THROWS_AS(write_atomically(fifo, [](const std::string& t) { write_text(t, "x"); }), InputError);
+    CHECK_THROWS_AS(write_atomically(fifo, [](const std::string& t) { write_text(t, "x"); }),
+                    InputError);
     struct stat st {};
     REQUIRE(::stat(fifo.c_str(), &st) == 0);
     CHECK(S_ISFIFO(st.st_mode));
@@ -127,23 +131,25 @@ TEST_CASE("two outputs that are the same file are refused", "[outputs][hostile]"
     TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
     const std::string exr = dir / "a.exr";
     SECTION("the same name") {
-        const ProcessResult r = run_process(MCRT_EXE, with(small_render(exr), {"--png", exr}), logs.path(), 60);
+        const ProcessResult r =
+            run_process(MCRT_EXE, with(small_render(exr), {"--png", exr}), logs.path(), 60);
         require_one_error(r, 2, "the same file as --out");
         CHECK_FALSE(fs::exists(exr));
     }
     SECTION("the same name written differently") {
         const ProcessResult r = run_process(
-            MCRT_EXE, with(small_render(exr), {"--stats", dir.path().string() + "/./a.exr"}), logs.path(), 60);
+            MCRT_EXE, with(small_render(exr), {"--stats", dir.path().string() + "/./a.exr"}),
+            logs.path(), 60);
         require_one_error(r, 2, "the same file as --out");
     }
     SECTION("a hard link and a symbolic link to an existing output") {
         write_text(exr, "precious");
         fs::create_hard_link(exr, dir / "hard.json");
         fs::create_symlink(exr, dir / "soft.png");
-        for (const auto& [option, other] :
-             std::vector<std::pair<std::string, std::string>>{{"--stats", dir / "hard.json"},
-                                                              {"--png", dir / "soft.png"}}) {
-            const ProcessResult r = run_process(MCRT_EXE, with(small_render(exr), {option, other}), logs.path(), 60);
+        for (const auto& [option, other] : std::vector<std::pair<std::string, std::string>>{
+                 {"--stats", dir / "hard.json"}, {"--png", dir / "soft.png"}}) {
+            const ProcessResult r =
+                run_process(MCRT_EXE, with(small_render(exr), {option, other}), logs.path(), 60);
             require_one_error(r, 2, "the same file as --out");
             CHECK(read_whole_file(exr) == "precious");
         }
@@ -159,13 +165,16 @@ TEST_CASE("an output that is an input (the scene or its buffer) is refused", "[o
     const std::string scene = read_whole_file(dir / "box.gltf");
     const std::string buffer = read_whole_file(dir / "CornellBox-Original.bin");
     auto args = [&](const std::string& out) {
-        return std::vector<std::string>{"render", dir / "box.gltf", "--width", "8", "--height", "8",
-                                        "--spp", "16", "--quiet", "--out", out};
+        return std::vector<std::string>{
+            "render", dir / "box.gltf", "--width", "8", "--height", "8", "--spp",
+            "16",     "--quiet",        "--out",   out};
     };
-    require_one_error(run_process(MCRT_EXE, args(dir / "box.gltf"), logs.path(), 60), 2, "is the input");
-    require_one_error(run_process(MCRT_EXE, with(args(dir / "a.exr"), {"--png", dir / "CornellBox-Original.bin"}),
-                                  logs.path(), 60),
-                      2, "is the input");
+    require_one_error(run_process(MCRT_EXE, args(dir / "box.gltf"), logs.path(), 60), 2,
+                      "is the input");
+    require_one_error(
+        run_process(MCRT_EXE, with(args(dir / "a.exr"), {"--png", dir / "CornellBox-Original.bin"}),
+                    logs.path(), 60),
+        2, "is the input");
     CHECK(read_whole_file(dir / "box.gltf") == scene);
     CHECK(read_whole_file(dir / "CornellBox-Original.bin") == buffer);
     CHECK_FALSE(fs::exists(dir / "a.exr"));
@@ -179,8 +188,9 @@ TEST_CASE("a write that fails names the reason, exits 1 and leaves no temporary 
     TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
     for (const std::string tmpfile : {"", "MCRT_TEST_NO_TMPFILE=1"}) {
         DYNAMIC_SECTION("temporary " << (tmpfile.empty() ? "unnamed" : "named")) {
-            std::vector<std::string> args = {MCRT_EXE, "render", kCornell, "--width", "64", "--height", "48",
-                                             "--spp", "16", "--quiet", "--out", dir / "a.exr",
+            std::vector<std::string> args = {MCRT_EXE,  "render",      kCornell, "--width",
+                                             "64",      "--height",    "48",     "--spp",
+                                             "16",      "--quiet",     "--out",  dir / "a.exr",
                                              "--stats", dir / "a.json"};
             write_text(dir / "a.json", "old stats");
             std::vector<std::string> env = {"MCRT_TEST_PAUSE=before-write",
@@ -206,7 +216,8 @@ TEST_CASE("a write that fails names the reason, exits 1 and leaves no temporary 
     }
 }
 
-TEST_CASE("SIGKILL while an output is written leaves no temporary file", "[outputs][signals][hostile]") {
+TEST_CASE("SIGKILL while an output is written leaves no temporary file",
+          "[outputs][signals][hostile]") {
     TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
     const std::string exr = dir / "a.exr";
     std::vector<std::string> args = small_render(exr);
@@ -253,8 +264,9 @@ TEST_CASE("a closed stderr pipe does not kill mcrt: the image is still written",
           "[signals][hostile]") {
     // `mcrt render … 2>&1 | head -c 10` with head gone.
     TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
-    std::vector<std::string> args = {MCRT_EXE, "render", kCornell, "--width", "16", "--height", "12",
-                                     "--spp", "16", "--out", dir / "a.exr"};
+    std::vector<std::string> args = {MCRT_EXE, "render",   kCornell,     "--width",
+                                     "16",     "--height", "12",         "--spp",
+                                     "16",     "--out",    dir / "a.exr"};
     Child child(args, {}, logs / "log", true);
     const int status = child.wait(60);
     REQUIRE_FALSE(child.timed_out());
@@ -289,9 +301,11 @@ TEST_CASE("error messages name the real cause", "[cli][hostile]") {
     }
     SECTION("an unusable PoCL cache directory is not 'no device'") {
         write_text(dir / "file", "x");
-        std::string command = "POCL_CACHE_DIR='" + (dir / "file") + "/pocl' exec '" + MCRT_EXE + "' devices";
+        std::string command =
+            "POCL_CACHE_DIR='" + (dir / "file") + "/pocl' exec '" + MCRT_EXE + "' devices";
         const ProcessResult r = run_process("/bin/sh", {"-c", command}, logs.path(), 30);
-        if (r.exit_code == 0) skip_test("this OpenCL platform does not need PoCL's cache directory");
+        if (r.exit_code == 0)
+            skip_test("this OpenCL platform does not need PoCL's cache directory");
         require_one_error(r, 1, "kernel cache directory");
     }
 }
@@ -304,13 +318,15 @@ TEST_CASE("an image too large for host memory is refused before rendering", "[me
     const uint64_t available = available_host_bytes();
     if (available == 0 || available >= need) skip_test("this machine has room for a 16384² render");
     TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
-    const ProcessResult r = run_process(
-        MCRT_EXE, {"render", kCornell, "--width", "16384", "--height", "16384", "--spp", "1", "--quiet",
-                   "--out", dir / "a.exr"}, logs.path(), 60);
+    const ProcessResult r = run_process(MCRT_EXE,
+                                        {"render", kCornell, "--width", "16384", "--height",
+                                         "16384", "--spp", "1", "--quiet", "--out", dir / "a.exr"},
+                                        logs.path(), 60);
     require_one_error(r, 1, "of host memory");
     CHECK(names_in(dir.path()).empty());
     const ProcessResult b = run_process(
-        MCRT_EXE, {"bench", kCornell, "--width", "16384", "--height", "16384", "--repeats", "1"}, logs.path(), 60);
+        MCRT_EXE, {"bench", kCornell, "--width", "16384", "--height", "16384", "--repeats", "1"},
+        logs.path(), 60);
     require_one_error(b, 1, "memory");
 }
 
@@ -319,16 +335,18 @@ TEST_CASE("an output through a symbolic link replaces the link's target and keep
     TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
     fs::create_directory(dir.path() / "real");
     struct Link {
-        std::string name;                       // the link the option names
+        std::string name;                                        // the link the option names
         std::vector<std::pair<std::string, std::string>> chain;  // link → what it holds
-        std::string target;                     // the file that must receive the output
+        std::string target;  // the file that must receive the output
     };
     for (const std::string option : {"--out", "--png", "--stats"}) {
         const std::string ext = option == "--out" ? ".exr" : option == "--png" ? ".png" : ".json";
         const std::vector<Link> links = {
             {"absolute", {{"absolute" + ext, dir / ("real/abs" + ext)}}, "real/abs" + ext},
             {"relative", {{"relative" + ext, "real/rel" + ext}}, "real/rel" + ext},
-            {"chain", {{"chain" + ext, "middle" + ext}, {"middle" + ext, "real/end" + ext}}, "real/end" + ext},
+            {"chain",
+             {{"chain" + ext, "middle" + ext}, {"middle" + ext, "real/end" + ext}},
+             "real/end" + ext},
             {"dangling", {{"dangling" + ext, "real/new" + ext}}, "real/new" + ext},
         };
         for (const Link& link : links) {
@@ -336,7 +354,8 @@ TEST_CASE("an output through a symbolic link replaces the link's target and keep
                 for (const auto& [name, to] : link.chain) fs::create_symlink(to, dir / name);
                 if (link.name != "dangling") write_text(dir / link.target, "old");
                 const std::string named = dir / link.chain.front().first;
-                std::vector<std::string> args = small_render(option == "--out" ? named : dir / "a.exr");
+                std::vector<std::string> args =
+                    small_render(option == "--out" ? named : dir / "a.exr");
                 if (option != "--out") args = with(args, {option, named});
                 const ProcessResult r = run_process(MCRT_EXE, args, logs.path(), 60);
                 INFO(r.err);
@@ -347,21 +366,26 @@ TEST_CASE("an output through a symbolic link replaces the link's target and keep
                 }
                 const std::string written = read_whole_file(dir / link.target);
                 CHECK(written.size() > 100);
-                if (option == "--stats") CHECK(nlohmann::json::parse(written)["seed"] == 0);
-                else if (option == "--out") CHECK(read_exr(dir / link.target).width == 16);
+                if (option == "--stats")
+                    CHECK(nlohmann::json::parse(written)["seed"] == 0);
+                else if (option == "--out")
+                    CHECK(read_exr(dir / link.target).width == 16);
                 for (const fs::path& d : {dir.path(), dir.path() / "real"})
-                    for (const std::string& name : names_in(d)) CHECK(name.find(".tmp-") == std::string::npos);
+                    for (const std::string& name : names_in(d))
+                        CHECK(name.find(".tmp-") == std::string::npos);
             }
         }
     }
 }
 
-TEST_CASE("integrate --out through a symbolic link replaces the target", "[outputs][hostile][links]") {
+TEST_CASE("integrate --out through a symbolic link replaces the target",
+          "[outputs][hostile][links]") {
     TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
     write_text(dir / "real.csv", "old");
     fs::create_symlink("real.csv", dir / "link.csv");
     const ProcessResult r = run_process(
-        MCRT_EXE, {"integrate", "--n", "16", "--repeats", "2", "--out", dir / "link.csv"}, logs.path(), 60);
+        MCRT_EXE, {"integrate", "--n", "16", "--repeats", "2", "--out", dir / "link.csv"},
+        logs.path(), 60);
     INFO(r.err);
     REQUIRE(r.exit_code == 0);
     CHECK(fs::is_symlink(dir / "link.csv"));
@@ -376,11 +400,11 @@ TEST_CASE("/dev/stdout as an output: a redirected file is written, a pipe is ref
     const fs::path link = dir / "stdout";
     fs::create_symlink("/proc/self/fd/1", link);
     const std::string command = "exec '" + std::string(MCRT_EXE) + "' render '" + kCornell +
-                                "' --width 8 --height 8 --spp 16 --quiet --out '" + (dir / "a.exr") +
-                                "' --stats '" + link.string() + "'";
+                                "' --width 8 --height 8 --spp 16 --quiet --out '" +
+                                (dir / "a.exr") + "' --stats '" + link.string() + "'";
     SECTION("stdout redirected to a file") {
-        const ProcessResult r =
-            run_process("/bin/sh", {"-c", command + " > '" + (dir / "so.json") + "'"}, logs.path(), 60);
+        const ProcessResult r = run_process(
+            "/bin/sh", {"-c", command + " > '" + (dir / "so.json") + "'"}, logs.path(), 60);
         INFO(r.err);
         REQUIRE(r.exit_code == 0);
         CHECK(nlohmann::json::parse(read_whole_file(dir / "so.json"))["width"] == 8);
@@ -410,12 +434,14 @@ TEST_CASE("an output where no file can be created is refused before the scene is
     if (::geteuid() != 0) {  // root writes into a mode-555 directory regardless
         fs::create_directory(dir.path() / "readonly");
         fs::permissions(dir.path() / "readonly", fs::perms(0555));
-        cases.push_back({"in a read-only directory", dir / "readonly/x.json", "cannot create a file in"});
+        cases.push_back(
+            {"in a read-only directory", dir / "readonly/x.json", "cannot create a file in"});
     }
     for (const Case& c : cases) {
         DYNAMIC_SECTION("--stats " << c.label) {
             const ProcessResult r = run_process(
-                MCRT_EXE, {"render", dir / "no-scene.gltf", "--out", dir / "a.exr", "--stats", c.stats},
+                MCRT_EXE,
+                {"render", dir / "no-scene.gltf", "--out", dir / "a.exr", "--stats", c.stats},
                 logs.path(), 60);
             require_one_error(r, 2, "--stats " + c.stats + ": ");
             CHECK(r.err.find(c.reason) != std::string::npos);
@@ -440,7 +466,8 @@ TEST_CASE("the outputs of a render land together or not at all", "[outputs][host
     };
     SECTION("--stats that cannot be created: refused before rendering") {
         const ProcessResult r = run_process(
-            MCRT_EXE, with(small_render(dir / "a.exr"), {"--png", dir / "a.png", "--stats", "/proc/x.json"}),
+            MCRT_EXE,
+            with(small_render(dir / "a.exr"), {"--png", dir / "a.png", "--stats", "/proc/x.json"}),
             logs.path(), 60);
         require_one_error(r, 2, "--stats /proc/x.json");
         unchanged();
@@ -450,9 +477,10 @@ TEST_CASE("the outputs of a render land together or not at all", "[outputs][host
                         << (tmpfile.empty() ? "unnamed" : "named")) {
             // A 4x4 EXR is about 1.2 kB, the PNG 0.1 kB, the stats about 2 kB: a 1600-byte
             // file-size limit fails the stats alone.
-            std::vector<std::string> args = {MCRT_EXE, "render", kCornell, "--width", "4", "--height", "4",
-                                             "--spp", "16", "--quiet", "--out", dir / "a.exr",
-                                             "--png", dir / "a.png", "--stats", dir / "a.json"};
+            std::vector<std::string> args = {MCRT_EXE, "render",      kCornell,  "--width",
+                                             "4",      "--height",    "4",       "--spp",
+                                             "16",     "--quiet",     "--out",   dir / "a.exr",
+                                             "--png",  dir / "a.png", "--stats", dir / "a.json"};
             std::vector<std::string> env = {"MCRT_TEST_PAUSE=before-write",
                                             "MCRT_TEST_PAUSE_UNTIL=" + (logs / "go")};
             if (!tmpfile.empty()) env.push_back(tmpfile);
@@ -478,13 +506,16 @@ TEST_CASE("two renders into the same outputs leave one render's whole set", "[ou
     // (it says so at the hook "commit-wait") and then put down its own pair.
     TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
     auto args = [&](const std::string& seed) {
-        std::vector<std::string> a = with(small_render(dir / "a.exr"), {"--stats", dir / "a.json", "--seed", seed});
+        std::vector<std::string> a =
+            with(small_render(dir / "a.exr"), {"--stats", dir / "a.json", "--seed", seed});
         a.insert(a.begin(), MCRT_EXE);
         return a;
     };
-    Child first(args("1"), {"MCRT_TEST_PAUSE=commit", "MCRT_TEST_PAUSE_UNTIL=" + (logs / "go")}, logs / "log1");
+    Child first(args("1"), {"MCRT_TEST_PAUSE=commit", "MCRT_TEST_PAUSE_UNTIL=" + (logs / "go")},
+                logs / "log1");
     REQUIRE(first.wait_for_text("paused at commit", 60));
-    Child second(args("2"), {"MCRT_TEST_PAUSE=commit-wait", "MCRT_TEST_PAUSE_SECONDS=0"}, logs / "log2");
+    Child second(args("2"), {"MCRT_TEST_PAUSE=commit-wait", "MCRT_TEST_PAUSE_SECONDS=0"},
+                 logs / "log2");
     REQUIRE(second.wait_for_text("paused at commit-wait", 60));
     write_text(logs / "go", "");
     const int status1 = first.wait(60), status2 = second.wait(60);
@@ -505,8 +536,8 @@ TEST_CASE("one directory named two ways does not deadlock the commit", "[outputs
     fs::create_directory(dir / "out");
     fs::create_directory_symlink(dir / "out", dir / "alias");
     const std::string mcrt = std::string(MCRT_EXE), scene = kCornell;
-    const std::string render = "exec '" + mcrt + "' render '" + scene +
-                               "' --width 8 --height 8 --spp 16 --quiet ";
+    const std::string render =
+        "exec '" + mcrt + "' render '" + scene + "' --width 8 --height 8 --spp 16 --quiet ";
     std::string command;
     std::vector<fs::path> written;
     SECTION("relative and absolute") {
@@ -515,8 +546,7 @@ TEST_CASE("one directory named two ways does not deadlock the commit", "[outputs
         written = {dir / "out" / "o.exr", dir / "out" / "s.json"};
     }
     SECTION("a dot component") {
-        command = "cd '" + dir.string() + "' && " + render +
-                  "--out out/a.exr --png out/./a.png";
+        command = "cd '" + dir.string() + "' && " + render + "--out out/a.exr --png out/./a.png";
         written = {dir / "out" / "a.exr", dir / "out" / "a.png"};
     }
     SECTION("a linked directory") {
@@ -538,7 +568,8 @@ TEST_CASE("one directory named two ways does not deadlock the commit", "[outputs
         INFO(file);
         CHECK(fs::file_size(file) > 0);
     }
-    for (const std::string& name : names_in(dir / "out")) CHECK(name.find(".tmp-") == std::string::npos);
+    for (const std::string& name : names_in(dir / "out"))
+        CHECK(name.find(".tmp-") == std::string::npos);
 }
 
 TEST_CASE("a stop signal while another render commits into the same directory ends the wait",
@@ -547,13 +578,16 @@ TEST_CASE("a stop signal while another render commits into the same directory en
     // SIGTERM: it ends with one error line and no temporary, and render 1 still lands its set.
     TempDir dir("mcrt-hostile"), logs("mcrt-hostile-logs");
     auto args = [&](const std::string& name) {
-        std::vector<std::string> a = with(small_render(dir / (name + ".exr")), {"--stats", dir / (name + ".json")});
+        std::vector<std::string> a =
+            with(small_render(dir / (name + ".exr")), {"--stats", dir / (name + ".json")});
         a.insert(a.begin(), MCRT_EXE);
         return a;
     };
-    Child first(args("a"), {"MCRT_TEST_PAUSE=commit", "MCRT_TEST_PAUSE_UNTIL=" + (logs / "go")}, logs / "log1");
+    Child first(args("a"), {"MCRT_TEST_PAUSE=commit", "MCRT_TEST_PAUSE_UNTIL=" + (logs / "go")},
+                logs / "log1");
     REQUIRE(first.wait_for_text("paused at commit", 60));
-    Child second(args("b"), {"MCRT_TEST_PAUSE=commit-wait", "MCRT_TEST_PAUSE_SECONDS=0"}, logs / "log2");
+    Child second(args("b"), {"MCRT_TEST_PAUSE=commit-wait", "MCRT_TEST_PAUSE_SECONDS=0"},
+                 logs / "log2");
     REQUIRE(second.wait_for_text("paused at commit-wait", 60));
     std::this_thread::sleep_for(std::chrono::milliseconds(200));  // into flock(2)
     second.signal(SIGTERM);
@@ -562,7 +596,8 @@ TEST_CASE("a stop signal while another render commits into the same directory en
     CHECK_FALSE(second.timed_out());
     CHECK((WIFEXITED(status2) && WEXITSTATUS(status2) == 1));
     CHECK(lines_starting_with(second.output(), "mcrt: error:").size() == 1);
-    CHECK(second.output().find("stopped while another process was writing its outputs") != std::string::npos);
+    CHECK(second.output().find("stopped while another process was writing its outputs") !=
+          std::string::npos);
     write_text(logs / "go", "");
     const int status1 = first.wait(60);
     CHECK((WIFEXITED(status1) && WEXITSTATUS(status1) == 0));

@@ -1,7 +1,8 @@
 // Scenes that hang or crash the loader, values that overflow, silently wrong input
 // (docs/ROBUSTNESS.md, "Hostile input"). Each refusal is one InputError (exit 2 from mcrt
-// render) naming the cause; what is accepted with a warning warns once. Cases that hung or crashed the old loader
-// run through the mcrt executable, so that a regression fails the test instead of hanging it.
+// render) naming the cause; what is accepted with a warning warns once. Cases that hung or crashed
+// the old loader run through the mcrt executable, so that a regression fails the test instead of
+// hanging it.
 #include <sys/stat.h>
 #include <zlib.h>
 
@@ -60,10 +61,11 @@ struct Gltf {
         const size_t length = texcoords ? uv_at + 24 : 36 + 2 * indices.size();
         const std::string uv_attribute = texcoords ? R"(, "TEXCOORD_0": 2)" : "";
         const std::string uv_accessor =
-            texcoords ? R"(, {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2"})" : "";
-        const std::string uv_view =
-            texcoords ? R"(, {"buffer": 0, "byteOffset": )" + std::to_string(uv_at) + R"(, "byteLength": 24})"
+            texcoords ? R"(, {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2"})"
                       : "";
+        const std::string uv_view = texcoords ? R"(, {"buffer": 0, "byteOffset": )" +
+                                                    std::to_string(uv_at) + R"(, "byteLength": 24})"
+                                              : "";
         return "{" + asset + "," + extra + R"("scene": 0, "scenes": [{"nodes": )" + scene_nodes +
                R"(}], "nodes": )" + nodes + R"(, "materials": [)" + material +
                R"(], "meshes": [{"primitives": [{"attributes": {"POSITION": 0)" + uv_attribute +
@@ -74,7 +76,8 @@ struct Gltf {
   "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
                   {"buffer": 0, "byteOffset": 36, "byteLength": )" +
                std::to_string(2 * indices.size()) + "}" + uv_view + R"(],
-  "buffers": [{"byteLength": )" + std::to_string(length) + R"(, "uri": ")" + uri + R"("}]})";
+  "buffers": [{"byteLength": )" +
+               std::to_string(length) + R"(, "uri": ")" + uri + R"("}]})";
     }
 };
 
@@ -86,8 +89,9 @@ struct Loaded {
 Loaded load(const Gltf& g) {
     Loaded result;
     const std::string text = g.text();
-    result.scene = load_gltf_from_memory("test.gltf", std::vector<unsigned char>(text.begin(), text.end()),
-                                         [&](const std::string& w) { result.warnings.push_back(w); });
+    result.scene =
+        load_gltf_from_memory("test.gltf", std::vector<unsigned char>(text.begin(), text.end()),
+                              [&](const std::string& w) { result.warnings.push_back(w); });
     return result;
 }
 
@@ -108,9 +112,10 @@ void write_text(const fs::path& path, const std::string& text) {
 // `mcrt render` of `scene`: exit 2 with one error line holding `needle`, within the timeout.
 void require_render_refused(const std::string& scene, const std::string& needle) {
     TempDir logs("mcrt-hostile-logs");
-    const ProcessResult r = run_process(
-        MCRT_EXE, {"render", scene, "--width", "8", "--height", "8", "--spp", "16", "--quiet", "--out",
-                   logs / "a.exr"}, logs.path(), 30);
+    const ProcessResult r = run_process(MCRT_EXE,
+                                        {"render", scene, "--width", "8", "--height", "8", "--spp",
+                                         "16", "--quiet", "--out", logs / "a.exr"},
+                                        logs.path(), 30);
     INFO("stderr: " << r.err << " signal " << r.signal);
     REQUIRE_FALSE(r.timed_out);
     CHECK(r.exit_code == 2);
@@ -149,7 +154,8 @@ TEST_CASE("a uri or scene path naming a FIFO, directory or device is refused nam
     Gltf g;
     g.buffer_uri = "fifo.bin";
     write_text(dir / "fifo.gltf", g.text());
-    require_render_refused(dir / "fifo.gltf", "is a FIFO (named pipe); only regular files are read");
+    require_render_refused(dir / "fifo.gltf",
+                           "is a FIFO (named pipe); only regular files are read");
     g.buffer_uri = "dir.bin";
     write_text(dir / "dir.gltf", g.text());
     require_render_refused(dir / "dir.gltf", "is a directory; only regular files are read");
@@ -171,25 +177,35 @@ TEST_CASE("a uri or scene path naming a FIFO, directory or device is refused nam
 
 TEST_CASE("extensionsRequired naming an unimplemented extension is refused", "[gltf][hostile]") {
     Gltf g;
-    g.extra = R"("extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"],)";
-    CHECK(refusal(g).find("extensionsRequired names KHR_draco_mesh_compression") != std::string::npos);
-    g.extra = R"("extensionsUsed": ["KHR_materials_emissive_strength"], "extensionsRequired": ["KHR_materials_emissive_strength"],)";
+    g.extra =
+        R"("extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"],)";
+    CHECK(refusal(g).find("extensionsRequired names KHR_draco_mesh_compression") !=
+          std::string::npos);
+    g.extra =
+        R"("extensionsUsed": ["KHR_materials_emissive_strength"], "extensionsRequired": ["KHR_materials_emissive_strength"],)";
     CHECK(load(g).scene.triangle_count() == 1);
 }
 
-TEST_CASE("a hierarchy expanding to 2^30 node instances is refused before expanding", "[gltf][hostile]") {
+TEST_CASE("a hierarchy expanding to 2^30 node instances is refused before expanding",
+          "[gltf][hostile]") {
     // Node i lists node i + 1 twice: 2^31 − 1 instances from 31 nodes.
     std::string nodes = "[";
     for (int i = 0; i < 31; ++i) {
-        nodes += i < 30 ? "{\"children\": [" + std::to_string(i + 1) + ", " + std::to_string(i + 1) + "]}," : "{\"mesh\": 0}";
+        nodes += i < 30 ? "{\"children\": [" + std::to_string(i + 1) + ", " +
+                              std::to_string(i + 1) + "]},"
+                        : "{\"mesh\": 0}";
     }
     Gltf g;
     g.nodes = nodes + "]";
     const std::string why = refusal(g);
-    CHECK(why.find("expands to 2.14748e+09 node instances, more than 16777216") != std::string::npos);
+    CHECK(why.find("expands to 2.14748e+09 node instances, more than 16777216") !=
+          std::string::npos);
     // Many instances of a big mesh: refused by the triangle bound, before expanding.
     std::string few = "[";
-    for (int i = 0; i < 15; ++i) few += i < 14 ? "{\"children\": [" + std::to_string(i + 1) + ", " + std::to_string(i + 1) + "]}," : "{\"mesh\": 0}";
+    for (int i = 0; i < 15; ++i)
+        few += i < 14 ? "{\"children\": [" + std::to_string(i + 1) + ", " + std::to_string(i + 1) +
+                            "]},"
+                      : "{\"mesh\": 0}";
     Gltf big;
     big.nodes = few + "]";
     big.indices.assign(30000, 0);  // 10,000 (degenerate) triangles × 16,384 instances
@@ -220,8 +236,9 @@ TEST_CASE("textured scenes with damaged images or references are refused in one 
     huge.insert(huge.end(), ihdr.begin(), ihdr.end());
     huge.insert(huge.end(), 100, 0xA5);
     write_text(dir / "huge.png", std::string(huge.begin(), huge.end()));
-    require_render_refused(scene_with("huge.gltf", R"([{"uri": "huge.png"}])"),
-                           "image 0 (huge.png): 65536 × 65536 texels: more than the 16384 per side");
+    require_render_refused(
+        scene_with("huge.gltf", R"([{"uri": "huge.png"}])"),
+        "image 0 (huge.png): 65536 × 65536 texels: more than the 16384 per side");
     // An image uri naming a directory.
     fs::create_directory(dir / "dir.png");
     require_render_refused(scene_with("dir.gltf", R"([{"uri": "dir.png"}])"),
@@ -243,7 +260,8 @@ TEST_CASE("textured scenes with damaged images or references are refused in one 
     std::vector<unsigned char> zeros(size_t(64) << 20, 0);
     uLongf deflated_size = compressBound(uLong(zeros.size()));
     std::vector<unsigned char> deflated(deflated_size);
-    REQUIRE(compress2(deflated.data(), &deflated_size, zeros.data(), uLong(zeros.size()), 9) == Z_OK);
+    REQUIRE(compress2(deflated.data(), &deflated_size, zeros.data(), uLong(zeros.size()), 9) ==
+            Z_OK);
     deflated.resize(deflated_size);
     std::vector<unsigned char> bomb = png_signature();
     for (const std::vector<unsigned char>& chunk :
@@ -266,15 +284,18 @@ TEST_CASE("textured scenes with damaged images or references are refused in one 
 
 TEST_CASE("radiance that cannot be summed in single precision is refused", "[gltf][hostile]") {
     Gltf g;
-    g.material = R"({"emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 1e31}}})";
+    g.material =
+        R"({"emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 1e31}}})";
     CHECK(refusal(g).find("emission 1e+31 exceeds 1e+30") != std::string::npos);
     // Each instance's power is a float, their sum is not: 16 instances of 6e37.
     Gltf many;
     many.size = 1e11;
-    many.material = R"({"emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 1e15}}})";
+    many.material =
+        R"({"emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 1e15}}})";
     std::string nodes = "[", roots = "[";
     for (int i = 0; i < 16; ++i) {
-        nodes += std::string(i ? "," : "") + "{\"mesh\": 0, \"translation\": [0, " + std::to_string(i) + "e10, 0]}";
+        nodes += std::string(i ? "," : "") + "{\"mesh\": 0, \"translation\": [0, " +
+                 std::to_string(i) + "e10, 0]}";
         roots += std::string(i ? "," : "") + std::to_string(i);
     }
     many.nodes = nodes + "]";
@@ -284,10 +305,12 @@ TEST_CASE("radiance that cannot be summed in single precision is refused", "[glt
 
 TEST_CASE("a sky that overflows is refused, and non-finite pixels are counted", "[cli][hostile]") {
     TempDir logs("mcrt-hostile-logs");
-    const ProcessResult r = run_process(
-        MCRT_EXE, {"render", std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf", "--estimator",
-                   "ambient-cosine", "--sky", "1e38", "--width", "8", "--height", "8", "--quiet", "--out",
-                   logs / "a.exr"}, logs.path(), 60);
+    const ProcessResult r =
+        run_process(MCRT_EXE,
+                    {"render", std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf",
+                     "--estimator", "ambient-cosine", "--sky", "1e38", "--width", "8", "--height",
+                     "8", "--quiet", "--out", logs / "a.exr"},
+                    logs.path(), 60);
     INFO(r.err);
     CHECK(r.exit_code == 2);
     CHECK(r.err.find("--sky 1e38") != std::string::npos);
@@ -318,10 +341,13 @@ TEST_CASE("silently wrong input is refused or warned about once", "[gltf][hostil
     SECTION("wrong JSON types of known properties") {
         Gltf g;
         g.nodes = R"([{"mesh": "0"}])";
-        CHECK(refusal(g).find("nodes[0].mesh: expected an integer from 0 to 2147483647, found a string") != std::string::npos);
+        CHECK(refusal(g).find(
+                  "nodes[0].mesh: expected an integer from 0 to 2147483647, found a string") !=
+              std::string::npos);
         Gltf m;
         m.material = R"({"pbrMetallicRoughness": {"baseColorFactor": "red"}})";
-        CHECK(refusal(m).find("baseColorFactor: expected an array of numbers") != std::string::npos);
+        CHECK(refusal(m).find("baseColorFactor: expected an array of numbers") !=
+              std::string::npos);
         Gltf d;
         d.material = R"({"doubleSided": 1})";
         CHECK(refusal(d).find("doubleSided: expected a boolean") != std::string::npos);
@@ -373,7 +399,8 @@ TEST_CASE("silently wrong input is refused or warned about once", "[gltf][hostil
 
 // `text` with its first `from` replaced by `to` (which must be there), loaded from memory: the
 // refusal, or "(loaded)".
-std::string refusal_of_edit(const std::string& text, const std::string& from, const std::string& to) {
+std::string refusal_of_edit(const std::string& text, const std::string& from,
+                            const std::string& to) {
     std::string edited = text;
     const size_t at = edited.find(from);
     REQUIRE(at != std::string::npos);
@@ -404,57 +431,87 @@ TEST_CASE("integers that tinygltf would wrap, drop or turn negative are refused 
     };
     const Case cases[] = {
         {R"("material": 0)", R"("material": 4294967297)",
-         "meshes[0].primitives[0].material: expected an integer from 0 to 2147483647, found 4294967297"},
-        {R"("material": 0)", R"("material": -1)", "primitives[0].material: expected an integer from 0"},
-        {R"("material": 0)", R"("material": 1.0)", "primitives[0].material: expected an integer from 0 to 2147483647, found 1.0"},
-        {R"("material": 0)", R"("material": 18446744073709551617)", "primitives[0].material: expected an integer"},
-        {R"("indices": 1)", R"("indices": 4294967297)", "primitives[0].indices: expected an integer from 0"},
-        {R"("POSITION": 0)", R"("POSITION": 4294967296)", "primitives[0].attributes.POSITION: expected an integer from 0"},
-        {R"({"mesh": 0})", R"({"mesh": 4294967296})", "nodes[0].mesh: expected an integer from 0 to 2147483647, found 4294967296"},
-        {R"({"mesh": 0})", R"({"mesh": 0, "camera": 4294967296})", "nodes[0].camera: expected an integer from 0"},
-        {R"({"mesh": 0})", R"({"mesh": 0, "skin": -4294967296})", "nodes[0].skin: expected an integer from 0"},
-        {R"({"mesh": 0})", R"({"mesh": 0, "children": [4294967297]})", "nodes[0].children[0]: expected an integer from 0"},
-        {R"("nodes": [0])", R"("nodes": [4294967296])", "scenes[0].nodes[0]: expected an integer from 0"},
+         "meshes[0].primitives[0].material: expected an integer from 0 to 2147483647, found "
+         "4294967297"},
+        {R"("material": 0)", R"("material": -1)",
+         "primitives[0].material: expected an integer from 0"},
+        {R"("material": 0)", R"("material": 1.0)",
+         "primitives[0].material: expected an integer from 0 to 2147483647, found 1.0"},
+        {R"("material": 0)", R"("material": 18446744073709551617)",
+         "primitives[0].material: expected an integer"},
+        {R"("indices": 1)", R"("indices": 4294967297)",
+         "primitives[0].indices: expected an integer from 0"},
+        {R"("POSITION": 0)", R"("POSITION": 4294967296)",
+         "primitives[0].attributes.POSITION: expected an integer from 0"},
+        {R"({"mesh": 0})", R"({"mesh": 4294967296})",
+         "nodes[0].mesh: expected an integer from 0 to 2147483647, found 4294967296"},
+        {R"({"mesh": 0})", R"({"mesh": 0, "camera": 4294967296})",
+         "nodes[0].camera: expected an integer from 0"},
+        {R"({"mesh": 0})", R"({"mesh": 0, "skin": -4294967296})",
+         "nodes[0].skin: expected an integer from 0"},
+        {R"({"mesh": 0})", R"({"mesh": 0, "children": [4294967297]})",
+         "nodes[0].children[0]: expected an integer from 0"},
+        {R"("nodes": [0])", R"("nodes": [4294967296])",
+         "scenes[0].nodes[0]: expected an integer from 0"},
         {R"("scene": 0)", R"("scene": 4294967296)", "glTF.scene: expected an integer from 0"},
-        {R"({"bufferView": 0, "componentType": 5126)", R"({"bufferView": 4294967296, "componentType": 5126)",
+        {R"({"bufferView": 0, "componentType": 5126)",
+         R"({"bufferView": 4294967296, "componentType": 5126)",
          "accessors[0].bufferView: expected an integer from 0"},
-        {R"({"bufferView": 0, "componentType": 5126)", R"({"bufferView": 0, "byteOffset": -12, "componentType": 5126)",
+        {R"({"bufferView": 0, "componentType": 5126)",
+         R"({"bufferView": 0, "byteOffset": -12, "componentType": 5126)",
          "accessors[0].byteOffset: expected a non-negative integer, found -12"},
-        {R"("componentType": 5126)", R"("componentType": 5126.0)", "accessors[0].componentType: expected a non-negative integer, found 5126.0"},
-        {R"("buffer": 0, "byteOffset": 0)", R"("buffer": 4294967296, "byteOffset": 0)", "bufferViews[0].buffer: expected an integer from 0"},
-        {R"("buffer": 0, "byteOffset": 0)", R"("buffer": 0, "byteStride": 12.0, "byteOffset": 0)", "bufferViews[0].byteStride: expected a non-negative integer"},
+        {R"("componentType": 5126)", R"("componentType": 5126.0)",
+         "accessors[0].componentType: expected a non-negative integer, found 5126.0"},
+        {R"("buffer": 0, "byteOffset": 0)", R"("buffer": 4294967296, "byteOffset": 0)",
+         "bufferViews[0].buffer: expected an integer from 0"},
+        {R"("buffer": 0, "byteOffset": 0)", R"("buffer": 0, "byteStride": 12.0, "byteOffset": 0)",
+         "bufferViews[0].byteStride: expected a non-negative integer"},
         {R"("buffer": 0, "byteOffset": 0)", R"("buffer": 0, "target": 4294967296, "byteOffset": 0)",
          "bufferViews[0].target: expected an integer from -2147483648 to 2147483647"},
-        {R"("indices": 1)", R"("indices": 1, "mode": 4294967300)", "primitives[0].mode: expected an integer from -2147483648"},
-        {R"("indices": 1)", R"("indices": 1, "targets": [{"POSITION": 4294967296}])", "primitives[0].targets[0].POSITION: expected an integer from 0"},
-        {R"("scene": 0,)", R"("scene": 0, "skins": [{"joints": [0, 4294967296]}],)", "skins[0].joints[1]: expected an integer from 0"},
-        {R"("scene": 0,)", R"("scene": 0, "animations": [{"channels": [{"sampler": 0, "target": {"node": 4294967296}}]}],)",
+        {R"("indices": 1)", R"("indices": 1, "mode": 4294967300)",
+         "primitives[0].mode: expected an integer from -2147483648"},
+        {R"("indices": 1)", R"("indices": 1, "targets": [{"POSITION": 4294967296}])",
+         "primitives[0].targets[0].POSITION: expected an integer from 0"},
+        {R"("scene": 0,)", R"("scene": 0, "skins": [{"joints": [0, 4294967296]}],)",
+         "skins[0].joints[1]: expected an integer from 0"},
+        {R"("scene": 0,)",
+         R"("scene": 0, "animations": [{"channels": [{"sampler": 0, "target": {"node": 4294967296}}]}],)",
          "animations[0].channels[0].target.node: expected an integer from 0"},
-        {R"("scene": 0,)", R"("scene": 0, "textures": [{"source": 4294967296}],)", "textures[0].source: expected an integer from 0"},
-        {R"("scene": 0,)", R"("scene": 0, "textures": [{"sampler": 4294967296}],)", "textures[0].sampler: expected an integer from 0"},
-        {R"("scene": 0,)", R"("scene": 0, "images": [{"bufferView": 4294967296}],)", "images[0].bufferView: expected an integer from 0"},
-        {R"("scene": 0,)", R"("scene": 0, "samplers": [{"wrapS": 4294977793}],)", "samplers[0].wrapS: expected an integer from -2147483648"},
-        {R"("scene": 0,)", R"("scene": 0, "samplers": [{"magFilter": 4294976025}],)", "samplers[0].magFilter: expected an integer"},
+        {R"("scene": 0,)", R"("scene": 0, "textures": [{"source": 4294967296}],)",
+         "textures[0].source: expected an integer from 0"},
+        {R"("scene": 0,)", R"("scene": 0, "textures": [{"sampler": 4294967296}],)",
+         "textures[0].sampler: expected an integer from 0"},
+        {R"("scene": 0,)", R"("scene": 0, "images": [{"bufferView": 4294967296}],)",
+         "images[0].bufferView: expected an integer from 0"},
+        {R"("scene": 0,)", R"("scene": 0, "samplers": [{"wrapS": 4294977793}],)",
+         "samplers[0].wrapS: expected an integer from -2147483648"},
+        {R"("scene": 0,)", R"("scene": 0, "samplers": [{"magFilter": 4294976025}],)",
+         "samplers[0].magFilter: expected an integer"},
         {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}})",
          R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 4294967296}}})",
          "materials[0].pbrMetallicRoughness.baseColorTexture.index: expected an integer from 0"},
         {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}})",
          R"({"normalTexture": {"index": 0, "texCoord": 4294967297}})",
-         "materials[0].normalTexture.texCoord: expected an integer from 0 to 2147483647, found 4294967297"},
+         "materials[0].normalTexture.texCoord: expected an integer from 0 to 2147483647, found "
+         "4294967297"},
         {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}})",
          R"({"emissiveTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"texCoord": 4294967296}}}})",
-         "materials[0].emissiveTexture.extensions.KHR_texture_transform.texCoord: expected an integer from 0"},
+         "materials[0].emissiveTexture.extensions.KHR_texture_transform.texCoord: expected an "
+         "integer from 0"},
         {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}})",
          R"({"occlusionTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"offset": [0, 4294967296]}}}})",
-         "materials[0].occlusionTexture.extensions.KHR_texture_transform.offset[1]: expected a number, as an "
+         "materials[0].occlusionTexture.extensions.KHR_texture_transform.offset[1]: expected a "
+         "number, as an "
          "integer from -2147483648 to 2147483647"},
         {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}})",
          R"({"emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4294967297}}})",
-         "materials[0].extensions.KHR_materials_emissive_strength.emissiveStrength: expected a number"},
+         "materials[0].extensions.KHR_materials_emissive_strength.emissiveStrength: expected a "
+         "number"},
         {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}})",
          R"({"extensions": {"KHR_materials_specular": {"specularColorFactor": [1, 1, -4294967295]}}})",
          "KHR_materials_specular.specularColorFactor[2]: expected a number"},
-        {R"("byteLength": 36})", R"("byteLength": -36})", "bufferViews[0].byteLength: expected a non-negative integer"},
+        {R"("byteLength": 36})", R"("byteLength": -36})",
+         "bufferViews[0].byteLength: expected a non-negative integer"},
     };
     SECTION("every index, count and enumeration tinygltf parses, in the core and in extensions") {
         for (const Case& c : cases) {
@@ -467,18 +524,27 @@ TEST_CASE("integers that tinygltf would wrap, drop or turn negative are refused 
     SECTION("sparse accessors: count and offsets are ints") {
         const std::string sparse =
             R"({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "sparse": )";
-        CHECK(refusal_of_edit(text, R"({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"})",
-                              sparse + R"({"count": 4294967297, "indices": {"bufferView": 1, "componentType": 5123},
+        CHECK(refusal_of_edit(
+                  text, R"({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"})",
+                  sparse +
+                      R"({"count": 4294967297, "indices": {"bufferView": 1, "componentType": 5123},
                                            "values": {"bufferView": 0}}})")
-                  .find("accessors[0].sparse.count: expected an integer from 0") != std::string::npos);
-        CHECK(refusal_of_edit(text, R"({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"})",
-                              sparse + R"({"count": 1, "indices": {"bufferView": 1, "byteOffset": 4294967296, "componentType": 5123},
+                  .find("accessors[0].sparse.count: expected an integer from 0") !=
+              std::string::npos);
+        CHECK(
+            refusal_of_edit(
+                text, R"({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"})",
+                sparse +
+                    R"({"count": 1, "indices": {"bufferView": 1, "byteOffset": 4294967296, "componentType": 5123},
                                            "values": {"bufferView": 0}}})")
-                  .find("accessors[0].sparse.indices.byteOffset: expected an integer from 0") != std::string::npos);
-        CHECK(refusal_of_edit(text, R"({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"})",
-                              sparse + R"({"count": 1, "indices": {"bufferView": 1, "componentType": 5123},
+                .find("accessors[0].sparse.indices.byteOffset: expected an integer from 0") !=
+            std::string::npos);
+        CHECK(refusal_of_edit(
+                  text, R"({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"})",
+                  sparse + R"({"count": 1, "indices": {"bufferView": 1, "componentType": 5123},
                                            "values": {"bufferView": 4294967296}}})")
-                  .find("accessors[0].sparse.values.bufferView: expected an integer from 0") != std::string::npos);
+                  .find("accessors[0].sparse.values.bufferView: expected an integer from 0") !=
+              std::string::npos);
     }
     SECTION("what tinygltf keeps whole still loads") {
         // The largest int, as an index, is out of range rather than wrapped.
@@ -487,7 +553,8 @@ TEST_CASE("integers that tinygltf would wrap, drop or turn negative are refused 
         // An extension's large number written with a fraction is a double, kept whole.
         Gltf offset;
         offset.texcoords = true;
-        offset.extra = R"("images": [{"uri": ")" + data_uri("image/png", png_file(1, 8, 0, {{128}})) +
+        offset.extra = R"("images": [{"uri": ")" +
+                       data_uri("image/png", png_file(1, 8, 0, {{128}})) +
                        R"("}], "textures": [{"source": 0}],)";
         offset.material = R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0,
             "extensions": {"KHR_texture_transform": {"offset": [4294967296.0, -2147483648]}}}}})";
@@ -500,9 +567,10 @@ TEST_CASE("integers that tinygltf would wrap, drop or turn negative are refused 
         std::string wrapped = text;
         wrapped.replace(wrapped.find(R"("material": 0)"), 13, R"("material": 4294967297)");
         write_text(dir / "wrapped.gltf", wrapped);
-        require_render_refused(dir / "wrapped.gltf",
-                               "wrapped.gltf: meshes[0].primitives[0].material: expected an integer "
-                               "from 0 to 2147483647, found 4294967297");
+        require_render_refused(
+            dir / "wrapped.gltf",
+            "wrapped.gltf: meshes[0].primitives[0].material: expected an integer "
+            "from 0 to 2147483647, found 4294967297");
     }
 }
 
@@ -562,7 +630,8 @@ TEST_CASE("metallic-roughness factors are read, clamped with one warning, or ref
         g.material = R"({"extensions": {"KHR_materials_specular": {"specularFactor": "big"}}})";
         CHECK(refusal(g).find("specularFactor must be a finite number") != std::string::npos);
         Gltf c;
-        c.material = R"({"extensions": {"KHR_materials_specular": {"specularColorFactor": [1, -1, 1]}}})";
+        c.material =
+            R"({"extensions": {"KHR_materials_specular": {"specularColorFactor": [1, -1, 1]}}})";
         CHECK(refusal(c).find("specularColorFactor must be 3 finite non-negative numbers") !=
               std::string::npos);
         Gltf n;
@@ -571,7 +640,8 @@ TEST_CASE("metallic-roughness factors are read, clamped with one warning, or ref
     }
     SECTION("a file may require KHR_materials_specular") {
         Gltf g;
-        g.extra = R"("extensionsUsed": ["KHR_materials_specular"], "extensionsRequired": ["KHR_materials_specular"],)";
+        g.extra =
+            R"("extensionsUsed": ["KHR_materials_specular"], "extensionsRequired": ["KHR_materials_specular"],)";
         CHECK(load(g).scene.triangle_count() == 1);
     }
 }

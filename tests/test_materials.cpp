@@ -4,7 +4,6 @@
 // double-precision implementation of the specification's formulas, every direct estimator
 // unbiased on glossy planes under a quad light, and Lambertian scenes bitwise unchanged.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -16,10 +15,10 @@
 #include "cl/cl_error.h"
 #include "cl/program.h"
 #include "device_support.h"
-#include "kernel_program.h"
-#include "render/plan.h"
 #include "independent_renders.h"
+#include "kernel_program.h"
 #include "process_support.h"
+#include "render/plan.h"
 #include "render/render_program.h"
 #include "render/renderer.h"
 #include "scene/gltf_import.h"
@@ -63,7 +62,9 @@ struct TestMaterial {
 
 // ---- The specification's BRDF in double precision, written from glTF 2.0 Appendix B ---------
 
-double alpha_of(double roughness) { return std::max(roughness * roughness, double(MCRT_ALPHA_MIN)); }
+double alpha_of(double roughness) {
+    return std::max(roughness * roughness, double(MCRT_ALPHA_MIN));
+}
 
 dvec3 reference_brdf(const TestMaterial& m, dvec3 v, dvec3 l) {
     if (v.z <= 0 || l.z <= 0) return dvec3(0.0);
@@ -86,7 +87,8 @@ dvec3 reference_brdf(const TestMaterial& m, dvec3 v, dvec3 l) {
 using Device = KernelProgram;
 
 Device& device() {
-    static Device d("bsdf_test.cl", "-D MCRT_MATERIALS_GLTF -D LIGHT_SELECT_POWER -D SAMPLER_INDEPENDENT");
+    static Device d("bsdf_test.cl",
+                    "-D MCRT_MATERIALS_GLTF -D LIGHT_SELECT_POWER -D SAMPLER_INDEPENDENT");
     return d;
 }
 
@@ -106,8 +108,7 @@ Sampled sample(const TestMaterial& m, dvec3 wo, size_t n, cl_uint seed) {
     Device& d = device();
     gpu::Material g = m.packed();
     cl::Buffer out = d.output<cl_float4>(n), f = d.output<cl_float4>(n);
-    d.run("bsdf_samples", n, g, f4(wo), cl_uint(n), seed, out,
-          f);
+    d.run("bsdf_samples", n, g, f4(wo), cl_uint(n), seed, out, f);
     return {d.read<cl_float4>(out, n), d.read<cl_float4>(f, n)};
 }
 
@@ -115,9 +116,9 @@ void evaluate(const TestMaterial& m, dvec3 wo, const std::vector<cl_float4>& wi,
               std::vector<float>* pdf, std::vector<cl_float4>* f) {
     Device& d = device();
     gpu::Material g = m.packed();
-    cl::Buffer in = d.buffer(wi), p = d.output<float>(wi.size()), fb = d.output<cl_float4>(wi.size());
-    d.run("bsdf_evaluate", wi.size(), g, f4(wo),
-          cl_uint(wi.size()), in, p, fb);
+    cl::Buffer in = d.buffer(wi), p = d.output<float>(wi.size()),
+               fb = d.output<cl_float4>(wi.size());
+    d.run("bsdf_evaluate", wi.size(), g, f4(wo), cl_uint(wi.size()), in, p, fb);
     if (pdf) *pdf = d.read<float>(p, wi.size());
     if (f) *f = d.read<cl_float4>(fb, wi.size());
 }
@@ -195,7 +196,8 @@ TestMaterial dielectric(double roughness) {
 
 }  // namespace
 
-// ---- The GGX distribution ------------------------------------------------------------------------
+// ---- The GGX distribution
+// ------------------------------------------------------------------------
 
 TEST_CASE("GGX: D(m)(m.n) and the visible normals integrate to 1 (weak white furnace)",
           "[materials][ggx]") {
@@ -206,7 +208,8 @@ TEST_CASE("GGX: D(m)(m.n) and the visible normals integrate to 1 (weak white fur
     for (int i = 0; i < ns; ++i)
         for (int j = 0; j < np; ++j) {
             double s = (i + 0.5) / ns, t = 0.5 * kPi * s * s, p = 2.0 * kPi * (j + 0.5) / np;
-            m.push_back(f4(dvec3(std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t))));
+            m.push_back(
+                f4(dvec3(std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t))));
             weight.push_back(std::sin(t) * (kPi * s / ns) * (2.0 * kPi / np));
         }
     Device& d = device();
@@ -229,7 +232,8 @@ TEST_CASE("GGX: D(m)(m.n) and the visible normals integrate to 1 (weak white fur
         }
 }
 
-// ---- Sampling ---------------------------------------------------------------------------------------
+// ---- Sampling
+// ---------------------------------------------------------------------------------------
 
 TEST_CASE("glTF BSDF sampling matches its pdf (chi2)", "[materials][chi2]") {
     cl_uint seed = 1;
@@ -260,8 +264,9 @@ TEST_CASE("glTF BSDF sampling reports the full BRDF and its mixture pdf", "[mate
         size_t k = 0, mismatches = 0;
         for (size_t j = 0; j < s.wi_pdf.size(); ++j) {
             if (!(s.wi_pdf[j].s[3] > 0)) continue;
-            bool same = std::abs(pdf[k] - s.wi_pdf[j].s[3]) <= 1e-4 * pdf[k] &&
-                        glm::length(d3(f[k]) - d3(s.f_cos[j])) <= 1e-4 * glm::length(d3(f[k])) + 1e-12;
+            bool same =
+                std::abs(pdf[k] - s.wi_pdf[j].s[3]) <= 1e-4 * pdf[k] &&
+                glm::length(d3(f[k]) - d3(s.f_cos[j])) <= 1e-4 * glm::length(d3(f[k])) + 1e-12;
             mismatches += same ? 0 : 1;
             ++k;
         }
@@ -269,7 +274,8 @@ TEST_CASE("glTF BSDF sampling reports the full BRDF and its mixture pdf", "[mate
     }
 }
 
-// ---- The BRDF itself -------------------------------------------------------------------------------
+// ---- The BRDF itself
+// -------------------------------------------------------------------------------
 
 TEST_CASE("the kernel's BRDF is the specification's formulas", "[materials]") {
     std::mt19937 rng(5);
@@ -294,7 +300,8 @@ TEST_CASE("the kernel's BRDF is the specification's formulas", "[materials]") {
         double worst = 0;
         for (size_t k = 0; k < wi.size(); ++k) {
             // The device gets the directions rounded to float: compare there.
-            dvec3 exact = reference_brdf(mat, glm::normalize(d3(f4(wo))), glm::normalize(d3(wi[k])));
+            dvec3 exact =
+                reference_brdf(mat, glm::normalize(d3(f4(wo))), glm::normalize(d3(wi[k])));
             for (int c = 0; c < 3; ++c)
                 worst = std::max(worst, std::abs(f[k].s[c] - exact[c]) / std::max(exact[c], 1e-3));
         }
@@ -317,14 +324,13 @@ TEST_CASE("the glTF BRDF is reciprocal", "[materials]") {
         Device& d = device();
         gpu::Material g = mat.packed();
         cl::Buffer in = d.buffer(pairs), out = d.output<cl_float4>(pairs.size());
-        d.run("bsdf_swapped", pairs.size() / 2, g,
-              cl_uint(pairs.size() / 2), in, out);
+        d.run("bsdf_swapped", pairs.size() / 2, g, cl_uint(pairs.size() / 2), in, out);
         std::vector<cl_float4> f = d.read<cl_float4>(out, pairs.size());
         double worst = 0;
         for (size_t k = 0; k < pairs.size(); k += 2)
             for (int c = 0; c < 3; ++c)
-                worst = std::max(worst, std::abs(f[k].s[c] - f[k + 1].s[c]) /
-                                            std::max(1e-6, double(f[k].s[c])));
+                worst = std::max(
+                    worst, std::abs(f[k].s[c] - f[k + 1].s[c]) / std::max(1e-6, double(f[k].s[c])));
         INFO(mat.label << " roughness " << mat.roughness << ": worst relative asymmetry " << worst);
         CHECK(worst < 1e-4);
     }
@@ -350,7 +356,8 @@ TEST_CASE("a white metal reflects at most what arrives, at every angle", "[mater
                 sum2 += v * v;
             }
             double mean = sum / n, se = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
-            INFO("roughness " << roughness << " view " << view << ": albedo " << mean << " ± " << se);
+            INFO("roughness " << roughness << " view " << view << ": albedo " << mean << " ± "
+                              << se);
             CHECK(mean <= 1.0 + 4.5 * se);
             CHECK(mean > 0.25);  // GGX at α = 1 keeps 0.31 at normal incidence
         }
@@ -373,7 +380,8 @@ TEST_CASE("no NaN or Inf at roughness 0, grazing views, base colour 0 or 1", "[m
                     size_t bad = 0;
                     for (size_t k = 0; k < s.wi_pdf.size(); ++k) {
                         for (int c = 0; c < 4; ++c)
-                            bad += std::isfinite(s.wi_pdf[k].s[c]) && std::isfinite(s.f_cos[k].s[c]) &&
+                            bad += std::isfinite(s.wi_pdf[k].s[c]) &&
+                                           std::isfinite(s.f_cos[k].s[c]) &&
                                            std::isfinite(f[k].s[c])
                                        ? 0
                                        : 1;
@@ -486,14 +494,16 @@ TEST_CASE("a mirror-like metal (roughness 0) renders finite with every direct es
     }
 }
 
-// ---- Model no more than a scene needs --------------------------------------------------------------
+// ---- Model no more than a scene needs
+// --------------------------------------------------------------
 
 TEST_CASE("Lambertian scenes build without the microfacet code and render bitwise alike",
           "[materials]") {
     // The shipped Cornell box says metallic 0 with the default specular layer: glossy under
     // --materials gltf; the same file with KHR_materials_specular.specularFactor 0 says
     // Lambertian, and renders bitwise as --materials lambert does.
-    Scene as_exported = load_gltf(std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf", {});
+    Scene as_exported =
+        load_gltf(std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf", {});
     RenderSettings settings;
     settings.width = 24;
     settings.height = 24;

@@ -70,7 +70,7 @@ ProcessResult run_mpi(int ranks, const std::vector<std::string>& mcrt_args, cons
                       double timeout = 60) {
     // --bind-to none: OpenMPI binds each of up to 2 ranks to one core by default, which halves
     // a rank's CPU device (docs/MPI.md).
-    std::vector<std::string> a = {"--bind-to", "none", "--oversubscribe", "-n",
+    std::vector<std::string> a = {"--bind-to",           "none",  "--oversubscribe", "-n",
                                   std::to_string(ranks), MCRT_EXE};
     a.insert(a.end(), mcrt_args.begin(), mcrt_args.end());
     return run_process(mpirun(), a, dir.path(), timeout);
@@ -237,17 +237,18 @@ TEST_CASE("mpirun -n 2 renders the path-traced image of one process under the sk
     // Every rank derives --max-depth, --rr-depth, --sky and the --look-from camera from the same
     // command line; the path records come back in the runs' sums.
     TempDir dir;
-    const std::vector<std::string> paths = {"--max-depth", "8", "--rr-depth", "2", "--sky", "0.4",
-                                            "--look-from", "0,1,5", "--look-at", "0,1,0",
-                                            "--estimator", "mis"};
+    const std::vector<std::string> paths = {"--max-depth", "8",     "--rr-depth",  "2",
+                                            "--sky",       "0.4",   "--look-from", "0,1,5",
+                                            "--look-at",   "0,1,0", "--estimator", "mis"};
     auto with = [&](std::vector<std::string> extra) {
         extra.insert(extra.end(), paths.begin(), paths.end());
         return extra;
     };
-    ProcessResult one =
-        run_process(MCRT_EXE, render_args(dir / "one.exr", with({"--stats", dir / "one.json"})), dir.path());
+    ProcessResult one = run_process(
+        MCRT_EXE, render_args(dir / "one.exr", with({"--stats", dir / "one.json"})), dir.path());
     REQUIRE(one.exit_code == 0);
-    ProcessResult two = run_mpi(2, render_args(dir / "two.exr", with({"--stats", dir / "two.json"})), dir);
+    ProcessResult two =
+        run_mpi(2, render_args(dir / "two.exr", with({"--stats", dir / "two.json"})), dir);
     INFO("stderr: " << two.err);
     REQUIRE(two.exit_code == 0);
     Image a = read_exr(dir / "one.exr"), b = read_exr(dir / "two.exr");
@@ -268,9 +269,9 @@ TEST_CASE("mpirun -n 2 renders the image of one process under an environment map
     Image map(16, 8);
     for (size_t k = 0; k < map.rgb.size(); ++k) map.rgb[k] = k % 48 < 6 ? 40.0f : 0.3f;
     write_exr(dir / "map.exr", map);
-    const std::vector<std::string> env = {"--env", dir / "map.exr", "--env-rotate", "20",
-                                          "--max-depth", "3", "--look-from", "0,1,5",
-                                          "--look-at", "0,1,0", "--estimator", "mis"};
+    const std::vector<std::string> env = {
+        "--env",       dir / "map.exr", "--env-rotate", "20",    "--max-depth", "3",
+        "--look-from", "0,1,5",         "--look-at",    "0,1,0", "--estimator", "mis"};
     std::vector<std::string> one_args = render_args(dir / "one.exr", env);
     ProcessResult one = run_process(MCRT_EXE, one_args, dir.path());
     INFO("stderr: " << one.err);
@@ -290,9 +291,23 @@ TEST_CASE("mpirun -n 2 renders punctual lights as one process does, bit for bit"
     TempDir dir;
     const std::string scene = std::string(MCRT_SCENES) + "/punctual/punctual-lights.gltf";
     auto args = [&](const std::string& out) {
-        return std::vector<std::string>{"render", scene, "--width", "40", "--height", "32",
-                                        "--spp", "32", "--estimator", "mis", "--light-select",
-                                        "tree", "--max-depth", "3", "--quiet", "--out", out};
+        return std::vector<std::string>{"render",
+                                        scene,
+                                        "--width",
+                                        "40",
+                                        "--height",
+                                        "32",
+                                        "--spp",
+                                        "32",
+                                        "--estimator",
+                                        "mis",
+                                        "--light-select",
+                                        "tree",
+                                        "--max-depth",
+                                        "3",
+                                        "--quiet",
+                                        "--out",
+                                        out};
     };
     ProcessResult one = run_process(MCRT_EXE, args(dir / "one.exr"), dir.path());
     REQUIRE(one.exit_code == 0);
@@ -395,11 +410,11 @@ TEST_CASE("an estimator that crashes under mpirun: an error line per rank naming
                  "                const SampleStream* stream, uint* rays) {\n"
                  "    *(global volatile int*)(0x10) = 1;\n    return (float3)(0.0f);\n}\n";
     }
-    ProcessResult r = run_mpi(2,
-                              {"render", kCornell, "--out", dir / "x.exr", "--width", "16",
-                               "--height", "16", "--spp", "16", "--quiet", "--estimator-file",
-                               dir / "crash.cl"},
-                              dir, 60);
+    ProcessResult r =
+        run_mpi(2,
+                {"render", kCornell, "--out", dir / "x.exr", "--width", "16", "--height", "16",
+                 "--spp", "16", "--quiet", "--estimator-file", dir / "crash.cl"},
+                dir, 60);
     INFO("stderr: " << r.err);
     CHECK(!r.timed_out);
     CHECK(r.exit_code != 0);
@@ -546,17 +561,23 @@ TEST_CASE("a rank started with other options ends the job at once, naming the op
         const char* said;
     };
     const std::vector<Case> cases = {
-        {"image size", {"--width", "32"}, "rank 1 was started with --width 32, rank 0 with --width 48"},
-        {"estimator", {"--estimator", "mis"}, "rank 1 was started with --estimator mis, rank 0 with --estimator light-area"},
+        {"image size",
+         {"--width", "32"},
+         "rank 1 was started with --width 32, rank 0 with --width 48"},
+        {"estimator",
+         {"--estimator", "mis"},
+         "rank 1 was started with --estimator mis, rank 0 with --estimator light-area"},
         {"seed", {"--seed", "7"}, "rank 1 was started with --seed 7, rank 0 with --seed 0"},
         {"an output only rank 1 names", {"--png", dir / "x.png"}, "rank 1 was started with --png"},
-        {"an invalid value", {"--spp", "0"}, "rank 1 refused its command line: --spp: Value 0 not in range"},
+        {"an invalid value",
+         {"--spp", "0"},
+         "rank 1 refused its command line: --spp: Value 0 not in range"},
         {"an unknown option", {"--no-such-option"}, "rank 1 refused its command line: "},
     };
     for (const Case& c : cases) {
         DYNAMIC_SECTION(c.what) {
-            std::vector<std::string> rank0 = {"render", kCornell, "--height", "40", "--quiet",
-                                              "--out", dir / "x.exr"};
+            std::vector<std::string> rank0 = {"render",  kCornell, "--height",   "40",
+                                              "--quiet", "--out",  dir / "x.exr"};
             std::vector<std::string> rank1 = rank0;
             rank0.insert(rank0.end(), {"--width", "48"});
             if (c.rank1_extra.front() != "--width") rank1.insert(rank1.end(), {"--width", "48"});

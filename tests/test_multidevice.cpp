@@ -2,11 +2,9 @@
 // on the same cores. The image must be bitwise identical to one device's, survive a device
 // fault, and stop cleanly on a time limit or a signal.
 #include <catch2/catch.hpp>
-
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
-
 #include <nlohmann/json.hpp>
 
 #include "analytic_scenes.h"
@@ -76,12 +74,15 @@ TEST_CASE("two devices render the image of one device, bit for bit, both doing w
     Devices devices;
     Fixture f;
     // Independent samples (one replicate) and Sobol split into 8 replicates (200 = 8 · 25).
-    auto [sampler, replicates] = GENERATE(std::make_pair("independent", 1u), std::make_pair("sobol", 8u));
+    auto [sampler, replicates] =
+        GENERATE(std::make_pair("independent", 1u), std::make_pair("sobol", 8u));
     f.settings.sampler = sampler;
     f.settings.replicates = replicates;
     INFO(sampler << ", " << replicates << " replicate(s)");
-    RenderResult one = render(std::vector<const DeviceContext*>{devices.all[0]}, f.data, f.settings);
-    RenderResult other = render(std::vector<const DeviceContext*>{devices.all[1]}, f.data, f.settings);
+    RenderResult one =
+        render(std::vector<const DeviceContext*>{devices.all[0]}, f.data, f.settings);
+    RenderResult other =
+        render(std::vector<const DeviceContext*>{devices.all[1]}, f.data, f.settings);
     RenderResult both = render(devices.all, f.data, f.settings);
     CHECK(same_bits(one.image.rgb, both.image.rgb));
     CHECK(same_bits(one.image.variance, both.image.variance));
@@ -122,8 +123,10 @@ TEST_CASE("paths of depth 8 render bit for bit alike on one device or two and in
             settings.replicates = resolve_replicates(0, settings);
             settings.batch = 0;
             INFO(estimator << " / " << sampler);
-            RenderResult one = render(std::vector<const DeviceContext*>{devices.all[0]}, data, settings);
-            RenderResult other = render(std::vector<const DeviceContext*>{devices.all[1]}, data, settings);
+            RenderResult one =
+                render(std::vector<const DeviceContext*>{devices.all[0]}, data, settings);
+            RenderResult other =
+                render(std::vector<const DeviceContext*>{devices.all[1]}, data, settings);
             RenderResult both = render(devices.all, data, settings);
             settings.batch = 16;
             RenderResult batched = render(devices.all, data, settings);
@@ -139,14 +142,15 @@ TEST_CASE("paths of depth 8 render bit for bit alike on one device or two and in
         }
 }
 
-TEST_CASE("a device that fails mid-render is retired and the image is unchanged",
-          "[multidevice]") {
+TEST_CASE("a device that fails mid-render is retired and the image is unchanged", "[multidevice]") {
     Devices devices;
     Fixture f;
-    RenderResult reference = render(std::vector<const DeviceContext*>{devices.all[0]}, f.data, f.settings);
+    RenderResult reference =
+        render(std::vector<const DeviceContext*>{devices.all[0]}, f.data, f.settings);
     for (int failing : {0, 1}) {
         // Device `failing` fails at its first launch (every device is handed a first launch).
-        setenv("MCRT_FAULT_INJECT", (std::to_string(devices.all[failing]->info.index) + ":1").c_str(), 1);
+        setenv("MCRT_FAULT_INJECT",
+               (std::to_string(devices.all[failing]->info.index) + ":1").c_str(), 1);
         warnings.clear();
         RenderResult r = render(devices.all, f.data, f.settings, {}, {}, collect_warning);
         unsetenv("MCRT_FAULT_INJECT");
@@ -172,12 +176,14 @@ TEST_CASE("when every device fails the render is a runtime error", "[multidevice
 
 TEST_CASE("the command line renders on all devices and reports each one", "[multidevice][cli]") {
     TempDir dir;
-    std::vector<std::string> common = {"render", kCornell, "--width", "40", "--height", "32",
-                                       "--spp", "48", "--quiet"};
+    std::vector<std::string> common = {"render", kCornell, "--width", "40",     "--height",
+                                       "32",     "--spp",  "48",      "--quiet"};
     auto with = [&](const std::vector<std::string>& extra) { return concat(common, extra); };
-    ProcessResult one = run_process(MCRT_EXE, with({"--out", dir / "one.exr", "--device", "0"}), dir.path());
-    ProcessResult all = run_process(MCRT_EXE, with({"--out", dir / "all.exr", "--device", "all", "--stats",
-                                                    dir / "all.json"}), dir.path());
+    ProcessResult one =
+        run_process(MCRT_EXE, with({"--out", dir / "one.exr", "--device", "0"}), dir.path());
+    ProcessResult all = run_process(
+        MCRT_EXE, with({"--out", dir / "all.exr", "--device", "all", "--stats", dir / "all.json"}),
+        dir.path());
     REQUIRE(one.exit_code == 0);
     REQUIRE(all.exit_code == 0);
     Image a = read_exr(dir / "one.exr"), b = read_exr(dir / "all.exr");
@@ -192,20 +198,23 @@ TEST_CASE("the command line renders on all devices and reports each one", "[mult
     }
     // With the fault switch the command still succeeds, with one warning line.
     setenv("MCRT_FAULT_INJECT", "1:1", 1);
-    ProcessResult faulty = run_process(MCRT_EXE, with({"--out", dir / "faulty.exr", "--device", "all"}), dir.path());
+    ProcessResult faulty =
+        run_process(MCRT_EXE, with({"--out", dir / "faulty.exr", "--device", "all"}), dir.path());
     unsetenv("MCRT_FAULT_INJECT");
     REQUIRE(faulty.exit_code == 0);
     CHECK(lines_starting_with(faulty.err, "mcrt: warning:").size() == 1);
     CHECK(same_bits(a.rgb, read_exr(dir / "faulty.exr").rgb));
 }
 
-TEST_CASE("a time limit or SIGINT writes a valid partial image of whole chunks", "[multidevice][cli]") {
+TEST_CASE("a time limit or SIGINT writes a valid partial image of whole chunks",
+          "[multidevice][cli]") {
     TempDir dir;
     for (int how : {0, 1}) {
         std::string exr = dir / ("partial" + std::to_string(how) + ".exr");
-        std::vector<std::string> args = {"render", kCornell, "--width", "64", "--height", "64",
-                                         "--spp", "1000000", "--quiet", "--out", exr, "--stats",
-                                         dir / "partial.json"};
+        std::vector<std::string> args = {
+            "render", kCornell,  "--width",           "64",      "--height",
+            "64",     "--spp",   "1000000",           "--quiet", "--out",
+            exr,      "--stats", dir / "partial.json"};
         ProcessResult r;
         if (how == 0) {
             args.insert(args.end(), {"--time-limit", "1.5"});
@@ -228,9 +237,10 @@ TEST_CASE("a time limit or SIGINT writes a valid partial image of whole chunks",
         // The first spp samples of a longer render are those of a render of spp samples
         // (independent sampler): the partial image is exactly that render.
         std::string full = dir / "full.exr";
-        ProcessResult again = run_process(
-            MCRT_EXE, {"render", kCornell, "--width", "64", "--height", "64", "--spp",
-                       std::to_string(spp), "--quiet", "--out", full}, dir.path(), 120);
+        ProcessResult again = run_process(MCRT_EXE,
+                                          {"render", kCornell, "--width", "64", "--height", "64",
+                                           "--spp", std::to_string(spp), "--quiet", "--out", full},
+                                          dir.path(), 120);
         REQUIRE(again.exit_code == 0);
         CHECK(same_bits(img.rgb, read_exr(full).rgb));
     }
@@ -250,17 +260,20 @@ struct ScopedEnv {
 TEST_CASE("a device that computes wrong values is retired before its samples enter the image",
           "[multidevice][cli][agreement]") {
     TempDir dir;
-    const std::vector<std::string> common = {"render", kCornell, "--width", "40", "--height", "32",
-                                             "--spp", "48", "--estimator", "mis", "--quiet"};
+    const std::vector<std::string> common = {"render",      kCornell, "--width", "40",
+                                             "--height",    "32",     "--spp",   "48",
+                                             "--estimator", "mis",    "--quiet"};
     auto with = [&](const std::vector<std::string>& extra) { return concat(common, extra); };
-    ProcessResult one = run_process(MCRT_EXE, with({"--out", dir / "one.exr", "--device", "0"}), dir.path());
+    ProcessResult one =
+        run_process(MCRT_EXE, with({"--out", dir / "one.exr", "--device", "0"}), dir.path());
     REQUIRE(one.exit_code == 0);
     const Image reference = read_exr(dir / "one.exr");
     // The hook scales every sample of the named device by 1 + 2^-20: the 64 agreement pixels
     // differ, so the device is retired with one warning and the image is device 0's alone.
     ScopedEnv wrong({{"MCRT_TEST_WRONG_DEVICE", "1"}});
-    ProcessResult r = run_process(MCRT_EXE, with({"--out", dir / "all.exr", "--device", "all",
-                                                  "--stats", dir / "all.json"}), dir.path());
+    ProcessResult r = run_process(
+        MCRT_EXE, with({"--out", dir / "all.exr", "--device", "all", "--stats", dir / "all.json"}),
+        dir.path());
     INFO("stderr: " << r.err);
     REQUIRE(r.exit_code == 0);
     std::vector<std::string> warnings = lines_starting_with(r.err, "mcrt: warning:");
@@ -280,14 +293,17 @@ TEST_CASE("a device whose compiler crashes is retired with one line; with none l
     TempDir dir;
     // PoCL's builds run in a child process (as other drivers' do) when its own cache is off,
     // and the hook makes the child for device 1 die of SIGSEGV.
-    ScopedEnv env({{"POCL_KERNEL_CACHE", "0"}, {"MCRT_NO_KERNEL_CACHE", "1"},
+    ScopedEnv env({{"POCL_KERNEL_CACHE", "0"},
+                   {"MCRT_NO_KERNEL_CACHE", "1"},
                    {"MCRT_TEST_COMPILER_CRASH", "1"}});
-    const std::vector<std::string> common = {"render", kCornell, "--width", "32", "--height", "32",
-                                             "--spp", "16", "--quiet"};
+    const std::vector<std::string> common = {"render", kCornell, "--width", "32",     "--height",
+                                             "32",     "--spp",  "16",      "--quiet"};
     auto with = [&](const std::vector<std::string>& extra) { return concat(common, extra); };
-    ProcessResult one = run_process(MCRT_EXE, with({"--out", dir / "one.exr", "--device", "0"}), dir.path());
+    ProcessResult one =
+        run_process(MCRT_EXE, with({"--out", dir / "one.exr", "--device", "0"}), dir.path());
     REQUIRE(one.exit_code == 0);
-    ProcessResult all = run_process(MCRT_EXE, with({"--out", dir / "all.exr", "--device", "all"}), dir.path());
+    ProcessResult all =
+        run_process(MCRT_EXE, with({"--out", dir / "all.exr", "--device", "all"}), dir.path());
     INFO("stderr: " << all.err);
     REQUIRE(all.exit_code == 0);
     std::vector<std::string> warnings = lines_starting_with(all.err, "mcrt: warning:");
@@ -297,7 +313,8 @@ TEST_CASE("a device whose compiler crashes is retired with one line; with none l
     CHECK(warnings[0].find("-D MCRT_ESTIMATE=") != std::string::npos);  // the variant
     CHECK(same_bits(read_exr(dir / "one.exr").rgb, read_exr(dir / "all.exr").rgb));
 
-    ProcessResult alone = run_process(MCRT_EXE, with({"--out", dir / "alone.exr", "--device", "1"}), dir.path());
+    ProcessResult alone =
+        run_process(MCRT_EXE, with({"--out", dir / "alone.exr", "--device", "1"}), dir.path());
     INFO("stderr: " << alone.err);
     CHECK(alone.exit_code == 1);
     CHECK(lines_starting_with(alone.err, "mcrt: error:").size() == 1);

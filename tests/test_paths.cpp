@@ -196,8 +196,8 @@ TEST_CASE("the variance layer predicts the spread of path-traced renders for eve
     settings.spp = 32;
     settings.max_depth = 64;
     settings.rr_depth = 2;
-    GpuSceneData data =
-        gpu_scene_for(scene, looking_down(glm::vec3(0.1f, 0.0f, 0.2f), glm::radians(90.0f)), settings);
+    GpuSceneData data = gpu_scene_for(
+        scene, looking_down(glm::vec3(0.1f, 0.0f, 0.2f), glm::radians(90.0f)), settings);
     for (const EstimatorCase& v : path_cases({"mis", "light-area"}))
         for (const std::string& sampler : variant_names(kSamplerVariants)) {
             v.apply(settings);

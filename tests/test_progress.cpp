@@ -1,6 +1,5 @@
 // The progress bar's fraction: finished launches move it, the image's whole chunk rows floor it.
 #include <catch2/catch.hpp>
-
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -43,8 +42,9 @@ std::string written(std::FILE* file) {
 }
 }  // namespace
 
-TEST_CASE("without a terminal, progress is a line at the start, then per tenth, at most one a second",
-          "[cli][progress]") {
+TEST_CASE(
+    "without a terminal, progress is a line at the start, then per tenth, at most one a second",
+    "[cli][progress]") {
     const uint64_t pixels = 1000;
     std::FILE* log = std::tmpfile();
     REQUIRE(log);
@@ -55,15 +55,15 @@ TEST_CASE("without a terminal, progress is a line at the start, then per tenth, 
     };
     {
         ProgressBar bar(true, pixels, false, log);
-        bar.update(0, 100, {}, at(0.0));                            // the start: a line
-        bar.update(0, 100, {device_with(5 * pixels)}, at(1.5));     // 5%: no tenth yet
-        bar.update(0, 100, {device_with(12 * pixels)}, at(1.6));    // 12%: a line
-        bar.update(16, 100, {device_with(25 * pixels)}, at(2.0));   // 25%: 0.4 s later, none
-        bar.update(16, 100, {device_with(31 * pixels)}, at(2.6));   // 31%: a line
-        bar.update(32, 100, {device_with(39 * pixels)}, at(5.0));   // 39%: the same tenth
-        bar.update(96, 100, {device_with(100 * pixels)}, at(6.0));  // all launched: 90%
-        bar.update(100, 100, {device_with(100 * pixels)}, at(6.1)); // the image whole
-        bar.update(100, 100, {device_with(100 * pixels)}, at(6.2)); // once only
+        bar.update(0, 100, {}, at(0.0));                             // the start: a line
+        bar.update(0, 100, {device_with(5 * pixels)}, at(1.5));      // 5%: no tenth yet
+        bar.update(0, 100, {device_with(12 * pixels)}, at(1.6));     // 12%: a line
+        bar.update(16, 100, {device_with(25 * pixels)}, at(2.0));    // 25%: 0.4 s later, none
+        bar.update(16, 100, {device_with(31 * pixels)}, at(2.6));    // 31%: a line
+        bar.update(32, 100, {device_with(39 * pixels)}, at(5.0));    // 39%: the same tenth
+        bar.update(96, 100, {device_with(100 * pixels)}, at(6.0));   // all launched: 90%
+        bar.update(100, 100, {device_with(100 * pixels)}, at(6.1));  // the image whole
+        bar.update(100, 100, {device_with(100 * pixels)}, at(6.2));  // once only
     }
     const std::string text = written(log);
     std::fclose(log);

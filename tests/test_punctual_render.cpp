@@ -3,7 +3,6 @@
 // light selection the same image beside area lights; the direction estimators cannot see them
 // (a black image and one warning); two devices and MPI ranks render the same bytes.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -239,8 +238,8 @@ TEST_CASE("every light selection gives the same image of punctual and area light
     // the exact image (no occlusion) assumes.
     lights.push_back(directional_light({0.0f, -1.0f, -3.0f}, {0.4f, 0.5f, 0.6f}));
     // A hard-edged spot (inner = outer): the tree must still reach inside its cone.
-    lights.push_back(spot_light({-0.6f, 0.9f, -0.5f}, {0.0f, -1.0f, 0.0f}, {2.0f, 2.0f, 2.0f},
-                                25.0, 25.0));
+    lights.push_back(
+        spot_light({-0.6f, 0.9f, -0.5f}, {0.0f, -1.0f, 0.0f}, {2.0f, 2.0f, 2.0f}, 25.0, 25.0));
     const PunctualPlane scene(lights, true);
     RenderSettings settings;
     settings.width = 16;
@@ -269,11 +268,11 @@ TEST_CASE("the direction estimators cannot see punctual lights: a black image an
     for (const char* estimator :
          {"hemisphere-uniform", "hemisphere-cosine", "bsdf", "ambient-cosine", "light-area"}) {
         const std::string out = dir / (std::string(estimator) + ".exr");
-        const ProcessResult r = run_process(
-            MCRT_EXE,
-            {"render", scene, "--width", "16", "--height", "16", "--spp", "8", "--estimator",
-             estimator, "--out", out, "--quiet"},
-            dir.path());
+        const ProcessResult r =
+            run_process(MCRT_EXE,
+                        {"render", scene, "--width", "16", "--height", "16", "--spp", "8",
+                         "--estimator", estimator, "--out", out, "--quiet"},
+                        dir.path());
         INFO(estimator << ": " << r.err);
         REQUIRE(r.exit_code == 0);
         const std::vector<std::string> warnings = lines_starting_with(r.err, "mcrt: warning:");

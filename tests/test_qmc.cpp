@@ -3,7 +3,6 @@
 // error of light-area with Sobol samples keeps falling faster than 1/spp, as for a one-triangle
 // light. Errors measured from independent renders (the variance of a pixel across seeds).
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "analytic_scenes.h"
@@ -47,13 +46,15 @@ double pixel_variance(const DeviceContext& device, const GpuSceneData& data, Ren
         }
     }
     double v = 0;
-    for (size_t i = 0; i < n; ++i) v += (sum_sq[i] - sum[i] * sum[i] / seeds) / (seeds - 1) / double(n);
+    for (size_t i = 0; i < n; ++i)
+        v += (sum_sq[i] - sum[i] * sum[i] / seeds) / (seeds - 1) / double(n);
     return v;
 }
 
 }  // namespace
 
-TEST_CASE("Sobol's variance x spp keeps falling on a light made of two triangles", "[qmc][sampling]") {
+TEST_CASE("Sobol's variance x spp keeps falling on a light made of two triangles",
+          "[qmc][sampling]") {
     DeviceContext device = first_device();
     RenderSettings settings;
     // Pixels small enough that the pixel footprint's share of the error is small against the
@@ -74,8 +75,8 @@ TEST_CASE("Sobol's variance x spp keeps falling on a light made of two triangles
             settings.spp = 256;
             double v256 = pixel_variance(device, data, settings, 16) * 256;
             fall[triangles - 1] = v16 / v256;
-            INFO(select << ", " << triangles << " triangle(s): variance x spp " << v16 << " at 16 spp, "
-                        << v256 << " at 256 spp: falls " << v16 / v256 << "x");
+            INFO(select << ", " << triangles << " triangle(s): variance x spp " << v16
+                        << " at 16 spp, " << v256 << " at 256 spp: falls " << v16 / v256 << "x");
             CHECK(v16 / v256 >= 2.0);
             WARN(select << ", " << triangles << " triangle(s): variance x spp falls " << v16 / v256
                         << "x from 16 to 256 spp (" << v16 << " -> " << v256 << ")");

@@ -4,7 +4,6 @@
 // on a floor — each against its exact image (Lambert's formula), band by band, within the
 // renders' own standard errors, for every strategy that spawns rays.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <functional>
 #include <sstream>
@@ -27,8 +26,8 @@ constexpr uint32_t kFirstSeed = 90000;
 // Each check takes the next kRenders seeds, so that no two checks share random numbers (one
 // unlucky draw would otherwise repeat in every scene).
 uint32_t next_seed = kFirstSeed;
-constexpr int kSize = 16;   // image width and height
-constexpr int kBands = 4;   // horizontal bands of kSize / kBands rows, each checked on its own
+constexpr int kSize = 16;  // image width and height
+constexpr int kBands = 4;  // horizontal bands of kSize / kBands rows, each checked on its own
 
 // Where a scene designed around the origin in metres is put: p ↦ scale·p + shift, rounded to
 // float as the scene stores it. The exact images use the rounded positions.
@@ -38,7 +37,8 @@ struct Placement {
     glm::dvec3 operator()(glm::dvec3 p) const { return glm::dvec3(glm::vec3(scale * p + shift)); }
     std::string label() const {
         std::ostringstream s;
-        s << "scale " << scale << ", shift (" << shift.x << ", " << shift.y << ", " << shift.z << ")";
+        s << "scale " << scale << ", shift (" << shift.x << ", " << shift.y << ", " << shift.z
+          << ")";
         return s.str();
     }
 };
@@ -83,7 +83,8 @@ ExactImage exact_image(const Camera& camera,
     std::vector<double> coarse = exact_pixel_image(camera, kSize, kSize, 32, value);
     e.fine = exact_pixel_image(camera, kSize, kSize, 64, value);
     e.quadrature_error.resize(e.fine.size());
-    for (size_t i = 0; i < e.fine.size(); ++i) e.quadrature_error[i] = std::abs(e.fine[i] - coarse[i]);
+    for (size_t i = 0; i < e.fine.size(); ++i)
+        e.quadrature_error[i] = std::abs(e.fine[i] - coarse[i]);
     return e;
 }
 
@@ -164,7 +165,8 @@ struct QuadOverFloor {
     QuadOverFloor(double floor_width, const Placement& place) {
         const double h = floor_width / 2;
         uint32_t floor = add_material(scene, glm::vec3(kAlbedo));
-        glm::dvec3 f[4] = {place({-h, 0, -h}), place({-h, 0, h}), place({h, 0, h}), place({h, 0, -h})};
+        glm::dvec3 f[4] = {place({-h, 0, -h}), place({-h, 0, h}), place({h, 0, h}),
+                           place({h, 0, -h})};
         add_quad(scene, glm::vec3(f[0]), glm::vec3(f[1]), glm::vec3(f[2]), glm::vec3(f[3]), floor);
         floor_y = f[0].y;
         floor_half = h * place.scale;
@@ -181,7 +183,8 @@ struct QuadOverFloor {
         const double t = (floor_y - eye.y) / d.y;
         if (!(t > 0)) return glm::dvec3(0.0);
         glm::dvec3 p = eye + t * d;
-        if (std::abs(p.x - floor_centre.x) > floor_half || std::abs(p.z - floor_centre.z) > floor_half)
+        if (std::abs(p.x - floor_centre.x) > floor_half ||
+            std::abs(p.z - floor_centre.z) > floor_half)
             return glm::dvec3(0.0);
         p.y = floor_y;
         return kAlbedo / M_PI * Le * lambert_irradiance(light, p, {0, 1, 0}, 1.0);
@@ -233,8 +236,7 @@ TEST_CASE("whole scenes scaled from 1e-3 to 1e3 and moved 1e4 m render the same 
     DeviceContext device = first_device();
     std::vector<Placement> placements;
     for (double s : {1e-3, 1e-2, 1e-1, 1e1, 1e2, 1e3}) placements.push_back({s, glm::dvec3(0.0)});
-    for (double d : {1e2, 1e3, 1e4})
-        placements.push_back({1.0, glm::dvec3(d, 0.5 * d, -0.7 * d)});
+    for (double d : {1e2, 1e3, 1e4}) placements.push_back({1.0, glm::dvec3(d, 0.5 * d, -0.7 * d)});
     placements.push_back({1e3, glm::dvec3(1e4, 0.5e4, -0.7e4)});
     for (const Placement& place : placements) {
         QuadOverFloor q(20.0, place);
@@ -298,7 +300,8 @@ TEST_CASE("no light leaks into a box resting on a large floor, and none is lost 
         const double h = 1000;
         auto P = [&](double x, double y, double z) { return glm::vec3(place({x, y, z})); };
         add_quad(scene, P(-h, 0, -h), P(-h, 0, h), P(h, 0, h), P(h, 0, -h), floor);
-        // Outward-facing walls x = ±0.5, z = ±0.5 and the lid y = 1, counter-clockwise from outside.
+        // Outward-facing walls x = ±0.5, z = ±0.5 and the lid y = 1, counter-clockwise from
+        // outside.
         add_quad(scene, P(0.5, 0, -0.5), P(0.5, 1, -0.5), P(0.5, 1, 0.5), P(0.5, 0, 0.5), wall);
         add_quad(scene, P(-0.5, 0, 0.5), P(-0.5, 1, 0.5), P(-0.5, 1, -0.5), P(-0.5, 0, -0.5), wall);
         add_quad(scene, P(0.5, 0, 0.5), P(0.5, 1, 0.5), P(-0.5, 1, 0.5), P(-0.5, 0, 0.5), wall);
@@ -313,7 +316,7 @@ TEST_CASE("no light leaks into a box resting on a large floor, and none is lost 
                  glm::vec3(light[3]), m);
 
         const std::vector<Strategy> strategies = {
-            {"light-area", 1, 32}, {"light-solid-angle", 1, 32}, {"mis", 1, 32},
+            {"light-area", 1, 32}, {"light-solid-angle", 1, 32},  {"mis", 1, 32},
             {"bsdf", 1, 128},      {"hemisphere-cosine", 1, 128}, {"mis", 8, 32}};
 
         // Inside: the floor to the wall bases, from under the lid.
@@ -337,8 +340,8 @@ TEST_CASE("no light leaks into a box resting on a large floor, and none is lost 
 
         // Outside: the floor from the wall base (x = 0.5) to x = 1.4, below the light.
         const double floor_y = place({0, 0, 0}).y;
-        Camera outside = camera_at(place({0.95, 0.9, 0}), place({0.95, 0, 0}),
-                                   2 * std::atan(0.45 / 0.9));
+        Camera outside =
+            camera_at(place({0.95, 0.9, 0}), place({0.95, 0, 0}), 2 * std::atan(0.45 / 0.9));
         ExactImage exact = exact_image(outside, [&](glm::dvec3 eye, glm::dvec3 d) {
             glm::dvec3 p = eye + ((floor_y - eye.y) / d.y) * d;
             p.y = floor_y;
@@ -350,8 +353,9 @@ TEST_CASE("no light leaks into a box resting on a large floor, and none is lost 
     }
 }
 
-TEST_CASE("ambient occlusion next to a wall is exact on floors up to 200 km and far from the origin",
-          "[offsets][analytic]") {
+TEST_CASE(
+    "ambient occlusion next to a wall is exact on floors up to 200 km and far from the origin",
+    "[offsets][analytic]") {
     // The ambient estimators' scene (a wall x = 0 of height 1 and width 3 on a floor, under a
     // uniform sky) on large floors and moved away from the origin: at a floor point the
     // unoccluded share of (1/π)∫cosθ dω is 1 − F, F the wall's form factor.
@@ -361,9 +365,9 @@ TEST_CASE("ambient occlusion next to a wall is exact on floors up to 200 km and 
         double floor_width;
         Placement place;
     };
-    for (const Case& k : {Case{6.0, {}}, Case{2e3, {}}, Case{2e5, {}},
-                          Case{2e3, {1.0, glm::dvec3(1e4, 0.5e4, -0.7e4)}},
-                          Case{2e3, {1e3, glm::dvec3(0.0)}}}) {
+    for (const Case& k :
+         {Case{6.0, {}}, Case{2e3, {}}, Case{2e5, {}},
+          Case{2e3, {1.0, glm::dvec3(1e4, 0.5e4, -0.7e4)}}, Case{2e3, {1e3, glm::dvec3(0.0)}}}) {
         const Placement& place = k.place;
         auto P = [&](double x, double y, double z) { return glm::vec3(place({x, y, z})); };
         Scene scene;

@@ -1,14 +1,13 @@
 // The render pipeline against analytic images: a polygon light over a diffuse plane (exact
 // irradiance from Lambert's formula), emitters seen directly; batching independence.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <cstring>
 
+#include "analytic_scenes.h"
 #include "bvh/bvh.h"
 #include "device_support.h"
 #include "render/renderer.h"
-#include "analytic_scenes.h"
 #include "scene_builders.h"
 
 using namespace mcrt;
@@ -56,7 +55,8 @@ TEST_CASE("light-area is unbiased on a polygon light over a plane (Lambert's for
             // the standard error from the per-pixel variance of the mean (pixels independent).
             double sum = 0, sum_exact = 0, var_sum = 0;
             for (size_t p = 0; p < n; ++p) {
-                double v = r.image.rgb[3 * p + c], e = exact[3 * p + c], var = r.image.variance[3 * p + c];
+                double v = r.image.rgb[3 * p + c], e = exact[3 * p + c],
+                       var = r.image.variance[3 * p + c];
                 sum += v;
                 sum_exact += e;
                 var_sum += var;
@@ -127,8 +127,9 @@ TEST_CASE("the image is bitwise identical for any batch size, and changes with t
     settings.height = 12;
     settings.spp = 40;  // not a multiple of the chunk: the last chunk is short
     // Replicates included: each chunk holds 16 / K samples of each of the K replicates.
-    auto [sampler, replicates] = GENERATE(std::make_pair("independent", 1u), std::make_pair("sobol", 4u),
-                                          std::make_pair("stratified", 8u));
+    auto [sampler, replicates] =
+        GENERATE(std::make_pair("independent", 1u), std::make_pair("sobol", 4u),
+                 std::make_pair("stratified", 8u));
     settings.sampler = sampler;
     settings.replicates = replicates;
     INFO(sampler << ", " << replicates << " replicate(s)");
@@ -141,7 +142,8 @@ TEST_CASE("the image is bitwise identical for any batch size, and changes with t
     REQUIRE(a.devices[0].batches == 3);
     REQUIRE(b.devices[0].batches == 1);
     auto same_bits = [](const std::vector<float>& x, const std::vector<float>& y) {
-        return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(float)) == 0;
+        return x.size() == y.size() &&
+               std::memcmp(x.data(), y.data(), x.size() * sizeof(float)) == 0;
     };
     CHECK(same_bits(a.image.rgb, b.image.rgb));
     CHECK(same_bits(a.image.variance, b.image.variance));
@@ -154,7 +156,8 @@ TEST_CASE("the image is bitwise identical for any batch size, and changes with t
 
 TEST_CASE("a scene without lights renders black without error", "[render]") {
     Scene scene;
-    add_quad(scene, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, add_material(scene, glm::vec3(0.8f)));
+    add_quad(scene, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3},
+             add_material(scene, glm::vec3(0.8f)));
     RenderSettings settings;
     settings.width = 8;
     settings.height = 8;
@@ -168,9 +171,9 @@ TEST_CASE("a scene without lights renders black without error", "[render]") {
 TEST_CASE("batch sizes are whole chunks and never exceed the samples asked for", "[render]") {
     CHECK(batch_samples_per_pixel(1, 512, 512, 16) == 16);
     CHECK(batch_samples_per_pixel(17, 512, 512, 1024) == 32);
-    CHECK(batch_samples_per_pixel(0, 512, 512, 1024) == 16);    // 2^22 samples per launch
+    CHECK(batch_samples_per_pixel(0, 512, 512, 1024) == 16);  // 2^22 samples per launch
     CHECK(batch_samples_per_pixel(0, 64, 64, 1024) == 1024);
-    CHECK(batch_samples_per_pixel(0, 64, 64, 20) == 32);        // covers spp in one launch
+    CHECK(batch_samples_per_pixel(0, 64, 64, 20) == 32);  // covers spp in one launch
     CHECK(batch_samples_per_pixel(0, 16384, 16384, 4) == 16);
 }
 
@@ -182,7 +185,8 @@ TEST_CASE("an emitter of 1e30 renders a finite image and variance layer", "[rend
     add_quad(scene, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, floor);
     uint32_t light = add_material(scene, glm::vec3(0.0f), glm::vec3(1e30f));
     // Facing +Y, seen from above, covering the middle of the view.
-    add_quad(scene, {-0.3f, 0.5f, -0.3f}, {-0.3f, 0.5f, 0.3f}, {0.3f, 0.5f, 0.3f}, {0.3f, 0.5f, -0.3f}, light);
+    add_quad(scene, {-0.3f, 0.5f, -0.3f}, {-0.3f, 0.5f, 0.3f}, {0.3f, 0.5f, 0.3f},
+             {0.3f, 0.5f, -0.3f}, light);
     Camera camera = looking_down(glm::vec3(0.0f, 3.0f, 0.0f), glm::radians(60.0f));
     RenderSettings settings;
     settings.width = 16;

@@ -11,9 +11,9 @@
 #include <numeric>
 #include <random>
 
+#include "chi2.h"
 #include "cl/cl_error.h"
 #include "cl/program.h"
-#include "chi2.h"
 #include "device_support.h"
 #include "kernel_program.h"
 #include "render/discrete.h"
@@ -832,8 +832,9 @@ TEST_CASE("the remapped selection number is uniform within every choice (chi2)",
             // for a χ² cell are pooled by chi2_test's rule.
             std::vector<double> expected(observed.size());
             for (size_t k = 0; k < expected.size(); ++k) expected[k] = count[k / kBins] / kBins;
-            Chi2 r = chi2_test("remap " + std::string(name) + " weights " + std::to_string(vector_index),
-                               observed, expected);
+            Chi2 r =
+                chi2_test("remap " + std::string(name) + " weights " + std::to_string(vector_index),
+                          observed, expected);
             CHECK(r.statistic < r.critical);
         }
     }
@@ -869,7 +870,8 @@ TreeLights tree_lights(int n, uint32_t seed, int zero_power = 0) {
                         : dvec3(2 * unit(rng) - 1, 2 * unit(rng) - 1, 2 * unit(rng) - 1);
         dvec3 normal = sphere();
         if (unit(rng) < 0.2) normal = -glm::normalize(c + dvec3(1e-9));  // faces away from 0
-        dvec3 a = glm::normalize(glm::cross(normal, std::abs(normal.x) < 0.9 ? dvec3(1, 0, 0) : dvec3(0, 1, 0)));
+        dvec3 a = glm::normalize(
+            glm::cross(normal, std::abs(normal.x) < 0.9 ? dvec3(1, 0, 0) : dvec3(0, 1, 0)));
         dvec3 b = glm::cross(normal, a);
         double size = 0.05 * scale * (0.2 + unit(rng));
         dvec3 p0 = c, p1 = c + size * a, p2 = c + size * b;  // counter-clockwise about normal
@@ -889,7 +891,8 @@ TreeLights tree_lights(int n, uint32_t seed, int zero_power = 0) {
 
 // Shading points of the tests: positions in a cube a little larger than the lights', normals
 // uniform on the sphere.
-void tree_points(size_t count, uint32_t seed, std::vector<cl_float4>& p, std::vector<cl_float4>& n) {
+void tree_points(size_t count, uint32_t seed, std::vector<cl_float4>& p,
+                 std::vector<cl_float4>& n) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     for (size_t k = 0; k < count; ++k) {
@@ -905,7 +908,8 @@ struct TreeCase {
 };
 const std::vector<TreeCase> kTreeCases = {{1, 0}, {2, 0}, {5, 1}, {64, 3}, {1000, 10}, {0, 0}};
 
-TEST_CASE("light tree: every light in one slot, bounds hold what is below them", "[sampling][light-tree]") {
+TEST_CASE("light tree: every light in one slot, bounds hold what is below them",
+          "[sampling][light-tree]") {
     for (const TreeCase& c : kTreeCases) {
         INFO("lights " << c.n);
         TreeLights t = tree_lights(c.n, 7u + uint32_t(c.n), c.zero_power);
@@ -996,7 +1000,8 @@ struct TreeOnDevice {
     cl_uint n;
     cl::Buffer nodes, paths, p, normal;
     std::vector<cl_float4> points, normals;
-    TreeOnDevice(Device& d, const TreeCase& c, size_t point_count) : t(tree_lights(c.n, 11u + uint32_t(c.n), c.zero_power)) {
+    TreeOnDevice(Device& d, const TreeCase& c, size_t point_count)
+        : t(tree_lights(c.n, 11u + uint32_t(c.n), c.zero_power)) {
         LightTree tree = build_light_tree(t.lights, t.powers);
         n = cl_uint(t.lights.size());
         tree_points(point_count, 3u + uint32_t(c.n), points, normals);
@@ -1023,8 +1028,8 @@ TEST_CASE("light tree: pmfs sum to 1 at every point, the sampler reports the twi
               tree.p, tree.normal, pmf);
         std::vector<float> pmfs = d.read<float>(pmf, tree.n * kPoints);
         cl::Buffer out = d.output<cl_uint4>(kPoints * kPerPoint);
-        d.run("sample_light_tree_at", kPoints * kPerPoint, tree.nodes, tree.paths,
-              cl_uint(kPoints), cl_uint(kPerPoint), 0u, 5u, tree.p, tree.normal, out);
+        d.run("sample_light_tree_at", kPoints * kPerPoint, tree.nodes, tree.paths, cl_uint(kPoints),
+              cl_uint(kPerPoint), 0u, 5u, tree.p, tree.normal, out);
         std::vector<cl_uint4> s = d.read<cl_uint4>(out, kPoints * kPerPoint);
         size_t reachable = 0, wrong_twin = 0, zero_chosen = 0, out_of_range = 0, none_chosen = 0;
         for (size_t k = 0; k < kPoints; ++k) {
@@ -1071,9 +1076,10 @@ TEST_CASE("light tree: pmfs sum to 1 at every point, the sampler reports the twi
     }
 }
 
-TEST_CASE("light tree: selection frequencies match the pmf (chi2), stratified u stays stratified, "
-          "u_remap is uniform (chi2)",
-          "[sampling][light-tree]") {
+TEST_CASE(
+    "light tree: selection frequencies match the pmf (chi2), stratified u stays stratified, "
+    "u_remap is uniform (chi2)",
+    "[sampling][light-tree]") {
     Device& d = device();
     constexpr int kBins = 16;
     int tested = 0;
@@ -1113,8 +1119,10 @@ TEST_CASE("light tree: selection frequencies match the pmf (chi2), stratified u 
                 remap[size_t(x.s[0]) * kBins + size_t(r * kBins)] += 1;
             }
             CHECK(outside == 0);
-            for (size_t i = 0; i < tree.n; ++i) expected[i] = kSamples * double(pmfs[k * tree.n + i]);
-            for (size_t b = 0; b < remap.size(); ++b) remap_expected[b] = observed[b / kBins] / kBins;
+            for (size_t i = 0; i < tree.n; ++i)
+                expected[i] = kSamples * double(pmfs[k * tree.n + i]);
+            for (size_t b = 0; b < remap.size(); ++b)
+                remap_expected[b] = observed[b / kBins] / kBins;
             if (stratified == 0) {
                 Chi2 r = chi2_test(name + " frequencies", observed, expected);
                 CHECK(r.statistic < r.critical);
@@ -1128,7 +1136,8 @@ TEST_CASE("light tree: selection frequencies match the pmf (chi2), stratified u 
                 // ±sqrt(pmf·N) of independent samples.
                 double worst = 0;
                 for (size_t i = 0; i < tree.n; ++i)
-                    worst = std::max(worst, std::abs(observed[i] - expected[i]) / (2.0 + 1e-5 * expected[i]));
+                    worst = std::max(
+                        worst, std::abs(observed[i] - expected[i]) / (2.0 + 1e-5 * expected[i]));
                 INFO(name << ": worst |count - pmf N| / (2 + 1e-5 pmf N) " << worst);
                 CHECK(worst <= 1.0);
             }

@@ -2,7 +2,6 @@
 // requests gives, request by request, the bytes of a render planned and uploaded afresh
 // (plan_render + render()), and releases a scene's device buffers once nobody holds the scene.
 #include <catch2/catch.hpp>
-
 #include <cstring>
 
 #include "common/error.h"
@@ -35,7 +34,8 @@ RenderRequest request(const char* estimator, const char* light_select, const cha
 bool same_bytes(const Image& a, const Image& b) {
     return a.width == b.width && a.height == b.height && a.rgb.size() == b.rgb.size() &&
            std::memcmp(a.rgb.data(), b.rgb.data(), a.rgb.size() * sizeof(float)) == 0 &&
-           std::memcmp(a.variance.data(), b.variance.data(), a.variance.size() * sizeof(float)) == 0;
+           std::memcmp(a.variance.data(), b.variance.data(), a.variance.size() * sizeof(float)) ==
+               0;
 }
 
 // The render of `r` as a process of one render makes it: planned, laid out and uploaded afresh.
@@ -65,8 +65,7 @@ TEST_CASE("a session renders one loaded scene under many requests, each as a fre
     requests.push_back(look);
     requests.push_back(request("mis", "power", "independent"));  // the scene's camera again
     for (const RenderRequest& r : requests) {
-        INFO(r.settings.estimator << " " << r.settings.light_select << " "
-                                  << r.settings.sampler);
+        INFO(r.settings.estimator << " " << r.settings.light_select << " " << r.settings.sampler);
         const RenderPlan plan = plan_session_render(*scene, r, {});
         const RenderResult kept = session.render(scene, plan);
         CHECK(kept.spp == 16);

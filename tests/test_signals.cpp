@@ -120,11 +120,12 @@ TEST_CASE("SIGTERM ends a render on a slow device within seconds", "[signals][cl
                 dir.path(), 120, SIGTERM, after);
             check_outputs(dir.path(), r, size, size);
             CHECK(r.seconds < after + 6.0);  // the 3 s grace, a launch, the exit
-            if (size == 64) {  // the first chunk row is done well before the signal
+            if (size == 64) {                // the first chunk row is done well before the signal
                 CHECK(r.exit_code == 0);
             } else {  // 512x512x16 samples at this speed take about a minute
                 CHECK(r.exit_code == 1);
-                CHECK(r.err.find("before every pixel had its first 16 samples") != std::string::npos);
+                CHECK(r.err.find("before every pixel had its first 16 samples") !=
+                      std::string::npos);
             }
         }
     }
@@ -159,7 +160,8 @@ TEST_CASE("SIGHUP mid-render stops it as SIGINT does: the samples done, written,
 TEST_CASE("under nohup (SIGHUP ignored) a SIGHUP leaves the render to finish",
           "[signals][cli][supervisor]") {
     TempDir dir("mcrt-signals"), logs("mcrt-signals-logs");
-    struct sigaction ignore {}, old{};
+    struct sigaction ignore {
+    }, old{};
     ignore.sa_handler = SIG_IGN;
     sigemptyset(&ignore.sa_mask);
     sigaction(SIGHUP, &ignore, &old);  // inherited across posix_spawn and exec, as nohup does

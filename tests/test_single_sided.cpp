@@ -2,7 +2,6 @@
 // not there for camera, path and shadow rays alike, unless it transmits (DESIGN.md "Radiometric
 // contract"); kernels built with -D MCRT_SINGLE_SIDED only for a scene that has such a surface.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <string>
 #include <vector>
@@ -119,14 +118,16 @@ TEST_CASE("the camera sees a single-sided quad from the front, and what is behin
         add_level_quad(s, 0.0f, 2.0f, c.up, quad);
         const GpuSceneData data = gpu_scene_for(s, camera, settings);
         const std::vector<float> image = pixels(device, data, settings);
-        INFO(c.what << ": first pixel (" << image[0] << ", " << image[1] << ", " << image[2] << ")");
+        INFO(c.what << ": first pixel (" << image[0] << ", " << image[1] << ", " << image[2]
+                    << ")");
         CHECK(all_equal(image, c.expected));
     }
 }
 
-TEST_CASE("a single-sided occluder facing away from the point does not shadow it, for every "
-          "strategy alike",
-          "[single-sided][estimators]") {
+TEST_CASE(
+    "a single-sided occluder facing away from the point does not shadow it, for every "
+    "strategy alike",
+    "[single-sided][estimators]") {
     // A floor lit by a quad light 2 above it; between them, 1 above the floor, a larger
     // single-sided quad. The camera, below the quad, sees only the floor. Facing up (away from
     // the floor), the quad is absent for the floor's shadow rays and BSDF-sampled rays alike: the
@@ -168,8 +169,8 @@ TEST_CASE("a single-sided occluder facing away from the point does not shadow it
         INFO(estimators[e] << ": without the quad (" << o.mean.x << " +- " << o.standard_error.x
                            << "), facing away (" << a.mean.x << " +- " << a.standard_error.x
                            << "), facing the floor (" << f.mean.x << " +- " << f.standard_error.x
-                           << "), mis facing away (" << ref.mean.x << " +- "
-                           << ref.standard_error.x << ")");
+                           << "), mis facing away (" << ref.mean.x << " +- " << ref.standard_error.x
+                           << ")");
         CHECK(a.nan_samples == 0);
         for (int c = 0; c < 3; ++c) {
             // The strategies agree with each other (mis the reference) and with the open scene.
@@ -212,8 +213,9 @@ TEST_CASE("a single-sided glass sphere is hit from inside: transmissive surfaces
             CHECK(all_equal(image, glm::vec3(kind == 1 ? 1.0f : 0.0f)));
         }
     }
-    SECTION("refraction through a glass sphere on a culled floor renders the same bits as without "
-            "culling") {
+    SECTION(
+        "refraction through a glass sphere on a culled floor renders the same bits as without "
+        "culling") {
         // The floor is seen from its front only, so a single-sided floor (culling built in, the
         // glass not flagged) and a double-sided one (no culling code) must give the same image,
         // paths through the sphere's inside included.

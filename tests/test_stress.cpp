@@ -1,28 +1,26 @@
-// Stability where methods fail: the scenes of scenes/stress (scripts/scenes/make_stress_scenes.py) ×
-// every estimator × light selection render without NaN or Inf, and wherever an estimator's
+// Stability where methods fail: the scenes of scenes/stress (scripts/scenes/make_stress_scenes.py)
+// × every estimator × light selection render without NaN or Inf, and wherever an estimator's
 // standard error means something on them, its image mean matches the exact image (Lambert's
 // formula for every emitting triangle; the scenes have no occluders) within 4.5 standard errors
 // from independent renders, as in test_estimators.cpp. What each scene stresses:
 // scenes/stress/README.md.
-#include <catch2/catch.hpp>
-
 #include <algorithm>
+#include <catch2/catch.hpp>
 #include <cmath>
 #include <limits>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "analytic_scenes.h"
 #include "bvh/bvh.h"
 #include "device_support.h"
 #include "example_estimators.h"
-#include "independent_renders.h"
 #include "image/image.h"
+#include "independent_renders.h"
 #include "process_support.h"
 #include "render/renderer.h"
 #include "scene/gltf_import.h"
@@ -288,8 +286,8 @@ TEST_CASE("stress scenes: every example estimator file is finite and unbiased",
     REQUIRE(files.size() >= 2);
     for (const std::string& name : kStressScenes) {
         Scene scene = load_stress_scene(name);
-        GpuSceneData data =
-            make_gpu_scene(scene, build_bvh(scene), scene.cameras.front(), settings.width, settings.height);
+        GpuSceneData data = make_gpu_scene(scene, build_bvh(scene), scene.cameras.front(),
+                                           settings.width, settings.height);
         glm::dvec3 exact = image_mean(exact_image(scene, scene.cameras.front(), 16, 16));
         for (const std::string& file : files)
             for (const std::string& select : variant_names(kLightSelectVariants)) {
@@ -299,7 +297,8 @@ TEST_CASE("stress scenes: every example estimator file is finite and unbiased",
                 // alone, rarely: the built-in direction estimators' sample count (above).
                 // bsdf_directions.cl at 32 spp found grazing-light's light 0 to 5 times in
                 // 81920 samples, too few for its standard error to mean anything.
-                bool directions = settings.estimator_source.find("sample_light") == std::string::npos;
+                bool directions =
+                    settings.estimator_source.find("sample_light") == std::string::npos;
                 settings.spp = directions ? 256 : 32;
                 Renders r = independent_renders(device, data, settings, kRenders, kFirstSeed);
                 INFO(name << ": " << file << " / " << select << ": mean " << format(r.mean)

@@ -39,12 +39,14 @@ std::string estimator_file(const TempDir& dir, const std::string& name, const st
     return path;
 }
 
-const std::string kHang = "    volatile int forever = 1;\n    while (forever) {}\n    return (float3)(0.0f);";
+const std::string kHang =
+    "    volatile int forever = 1;\n    while (forever) {}\n    return (float3)(0.0f);";
 
 std::vector<std::string> render_args(const std::string& out, const std::string& estimator,
                                      std::vector<std::string> extra = {}) {
-    std::vector<std::string> a = {MCRT_EXE, "render", kCornell, "--width", "16", "--height", "16",
-                                  "--spp", "16", "--out", out, "--estimator-file", estimator};
+    std::vector<std::string> a = {MCRT_EXE, "render", kCornell, "--width", "16", "--height",
+                                  "16",     "--spp",  "16",     "--out",   out,  "--estimator-file",
+                                  estimator};
     a.insert(a.end(), extra.begin(), extra.end());
     return a;
 }
@@ -104,7 +106,8 @@ TEST_CASE("a hanging estimator is stopped by the time limit within the grace per
     CHECK(seconds_since(launched) < 1 + kSupervisorGraceSeconds + 3);
     require_one_error(exit_code(status), child.output(),
                       "the time limit of 1 s passed, but a launch on the devices did not return "
-                      "within 5 s of it with the estimator file " + hang,
+                      "within 5 s of it with the estimator file " +
+                          hang,
                       out);
 }
 
@@ -133,7 +136,8 @@ TEST_CASE("an estimator that crashes its process costs one error line naming the
           "[supervisor][cli]") {
     let_segv_through_sanitizer();
     const std::pair<const char*, const char*> crashes[] = {
-        {"a wild global pointer", "    *(global volatile int*)(0x10) = 1;\n    return (float3)(0.0f);"},
+        {"a wild global pointer",
+         "    *(global volatile int*)(0x10) = 1;\n    return (float3)(0.0f);"},
         {"a private index far out of bounds",
          "    volatile float a[4];\n    volatile int i = 100000000;\n    a[i] = 1.0f;\n"
          "    return (float3)(a[0]);"}};
@@ -147,7 +151,8 @@ TEST_CASE("an estimator that crashes its process costs one error line naming the
             REQUIRE_FALSE(r.timed_out);
             require_one_error(r.exit_code, r.err,
                               "the render died of signal 11 (SIGSEGV, Segmentation fault) while "
-                              "the devices ran the kernels with the estimator file " + file,
+                              "the devices ran the kernels with the estimator file " +
+                                  file,
                               out);
         }
     }
@@ -162,8 +167,8 @@ TEST_CASE("a render killed from outside with SIGKILL is one error line",
     REQUIRE(child.render_pid() != child.pid());
     ::kill(child.render_pid(), SIGKILL);  // as the kernel's out-of-memory killer does
     const int status = child.wait(30);
-    require_one_error(exit_code(status), child.output(), "the render was killed (SIGKILL: out of memory?)",
-                      out);
+    require_one_error(exit_code(status), child.output(),
+                      "the render was killed (SIGKILL: out of memory?)", out);
 }
 
 TEST_CASE("Ctrl-Z stops the render with its supervisor and fg continues both",
@@ -191,8 +196,8 @@ TEST_CASE("a render that works exits as without the supervisor, with the same im
           "[supervisor][cli]") {
     TempDir dir("mcrt-sup"), logs("mcrt-sup-logs");
     auto args = [&](const std::string& out) {
-        return std::vector<std::string>{"render", kCornell, "--width", "32", "--height", "24",
-                                        "--spp", "32", "--quiet", "--out", out};
+        return std::vector<std::string>{"render", kCornell, "--width", "32",    "--height", "24",
+                                        "--spp",  "32",     "--quiet", "--out", out};
     };
     const ProcessResult supervised = run_process(MCRT_EXE, args(dir / "a.exr"), logs.path(), 120);
     setenv("MCRT_NO_SUPERVISOR", "1", 1);
@@ -358,8 +363,9 @@ TEST_CASE("a device whose context is refused is skipped under --device all",
     // CL_CONFIG_CPU_TARGET_ARCH=junk (CL_DEVICE_NOT_AVAILABLE).
     TempDir dir("mcrt-sup"), logs("mcrt-sup-logs");
     auto args = [&](const std::string& out, const std::string& device) {
-        return std::vector<std::string>{"render", kCornell, "--width", "24", "--height", "16",
-                                        "--spp", "32", "--quiet", "--out", out, "--device", device};
+        return std::vector<std::string>{"render", kCornell,   "--width", "24",      "--height",
+                                        "16",     "--spp",    "32",      "--quiet", "--out",
+                                        out,      "--device", device};
     };
     setenv("POCL_DEVICES", "pthread basic", 1);
     const ProcessResult reference =

@@ -7,7 +7,6 @@
 //    blended light's, a coin per sample, by its mean over the label's pixels);
 //  - image means: within the light-area estimator's standard error over independent renders.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -59,7 +58,9 @@ RenderSettings view_settings(const json& view) {
     return settings;
 }
 
-glm::dvec3 vec(const json& a) { return {a[0].get<double>(), a[1].get<double>(), a[2].get<double>()}; }
+glm::dvec3 vec(const json& a) {
+    return {a[0].get<double>(), a[1].get<double>(), a[2].get<double>()};
+}
 
 // Every labelled pixel of the view: its legend's ratio to the twin's pixel, or its radiance.
 void check_labels(const std::string& name, const json& scene, const json& view) {
@@ -111,7 +112,8 @@ void check_labels(const std::string& name, const json& scene, const json& view) 
     for (const auto& [label, values] : by_label) {
         glm::dvec3 mean(0.0), var(0.0);
         for (const glm::dvec3& v : values) mean += v / double(values.size());
-        for (const glm::dvec3& v : values) var += (v - mean) * (v - mean) / double(values.size() - 1);
+        for (const glm::dvec3& v : values)
+            var += (v - mean) * (v - mean) / double(values.size() - 1);
         const glm::dvec3 want = vec(legend[label]["radiance"]);
         for (int c = 0; c < 3; ++c) {
             INFO(name << " camera " << camera << " label " << label << " channel " << c << ": mean "

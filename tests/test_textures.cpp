@@ -7,7 +7,6 @@
 //  - an emissive-textured light, a light cut by MASK and a BLEND light and occluder at alpha 0.5
 //    against Lambert's formula over what remains, within the estimators' own standard errors.
 #include <catch2/catch.hpp>
-
 #include <cmath>
 
 #include "analytic_scenes.h"
@@ -183,7 +182,8 @@ TEST_CASE("MASK on the floor: holes show what is behind (nothing), the rest is u
                 const glm::dvec3 p = floor_point(cam, 2.0 * (i + xs[k]) / settings.width - 1.0,
                                                  1.0 - 2.0 * (j + ys[k]) / settings.height);
                 alpha[k] = texture_lookup(masked.scene.images[image], floor.base_color_texture,
-                                          glm::vec2(p.x, p.z)).w;
+                                          glm::vec2(p.x, p.z))
+                               .w;
             }
             bool one = true;
             for (int k = 0; k < 4; ++k) one = one && alpha[k] == alpha[4];
@@ -263,11 +263,10 @@ TEST_CASE("an emissive-textured light lights the floor as its four texels would"
     PlaneScene ps;
     const PolygonLight quad = ps.lights[0];
     // 2 × 2 NEAREST texels, sRGB: the light's four squares emit Le × their linear values.
-    const glm::u8vec4 texels[4] = {{255, 255, 255, 255}, {128, 64, 32, 255},
-                                   {0, 0, 0, 255}, {200, 230, 90, 255}};
-    const uint32_t image = add_image(ps.scene, 2, 2, [&](uint32_t i, uint32_t j) {
-        return texels[2 * j + i];
-    });
+    const glm::u8vec4 texels[4] = {
+        {255, 255, 255, 255}, {128, 64, 32, 255}, {0, 0, 0, 255}, {200, 230, 90, 255}};
+    const uint32_t image =
+        add_image(ps.scene, 2, 2, [&](uint32_t i, uint32_t j) { return texels[2 * j + i]; });
     Material& light = ps.scene.materials[ps.scene.triangle_material[2]];
     light.emissive_texture.image = int32_t(image);
     light.emissive_texture.srgb = true;

@@ -2,7 +2,6 @@
 // in double precision on the same rays, a deep tree, and the watertightness of the ray–triangle
 // test.
 #include <catch2/catch.hpp>
-
 #include <cfloat>
 #include <cmath>
 #include <cstring>
@@ -85,8 +84,8 @@ double brute_force(const Scene& s, const glm::dvec3& o, const glm::dvec3& d, dou
     double best = t_max;
     *triangle = -1;
     for (size_t t = 0; t < s.triangle_count(); ++t) {
-        double th = reference_t(o, d, s.positions[3 * t], s.positions[3 * t + 1],
-                                s.positions[3 * t + 2]);
+        double th =
+            reference_t(o, d, s.positions[3 * t], s.positions[3 * t + 1], s.positions[3 * t + 2]);
         if (th < best) best = th, *triangle = int(t);
     }
     return best;
@@ -167,7 +166,8 @@ TEST_CASE("any hit on the device agrees with closest hit on segments", "[travers
     CHECK(blocked < 3500);
 }
 
-TEST_CASE("no ray escapes a closed mesh through its edges or vertices (watertight)", "[traversal]") {
+TEST_CASE("no ray escapes a closed mesh through its edges or vertices (watertight)",
+          "[traversal]") {
     Scene scene;
     uint32_t m = add_material(scene, glm::vec3(0.5f));
     add_sphere(scene, glm::vec3(0.3f, -0.2f, 0.1f), 1.0f, 48, 24, m);

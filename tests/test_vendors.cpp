@@ -3,9 +3,7 @@
 // that of --device all over both are the same bytes, for the determinism configurations. With
 // one implementation the cases skip.
 #include <catch2/catch.hpp>
-
 #include <map>
-
 #include <nlohmann/json.hpp>
 
 #include "cl/device.h"
@@ -48,18 +46,20 @@ TEST_CASE("every OpenCL implementation renders the same bytes, alone and togethe
         {"glossy mis", kGlossy, {"--estimator", "mis", "--materials", "gltf"}},
         {"Sobol mis on veach-mis", kVeach, {"--estimator", "mis", "--sampler", "sobol"}},
         {"depth-8 paths", kCornell, {"--estimator", "mis", "--max-depth", "8"}},
-        {"light tree, ambient sky", kCornell,
+        {"light tree, ambient sky",
+         kCornell,
          {"--estimator", "light-solid-angle", "--light-select", "tree", "--sky", "0.3"}},
         {"bilinear texture", kTextured + "checker_linear.gltf", {"--estimator", "mis"}},
         {"masked occluder", kTextured + "mask_occluder.gltf", {"--estimator", "light-area"}},
-        {"blended light, depth 3", kTextured + "blend_texture_light.gltf",
+        {"blended light, depth 3",
+         kTextured + "blend_texture_light.gltf",
          {"--estimator", "mis", "--max-depth", "3"}},
     };
     TempDir dir;
     for (const Configuration& c : configurations) {
         DYNAMIC_SECTION(c.name) {
-            std::vector<std::string> common = {"render", c.scene, "--width", "40", "--height",
-                                               "32", "--spp", "48", "--quiet"};
+            std::vector<std::string> common = {"render", c.scene, "--width", "40",     "--height",
+                                               "32",     "--spp", "48",      "--quiet"};
             common.insert(common.end(), c.options.begin(), c.options.end());
             auto render = [&](const std::string& device, const std::string& out) {
                 std::vector<std::string> args = common;
@@ -101,8 +101,9 @@ TEST_CASE("Intel's runtime refusing its context costs its device alone under --d
         skip_test("Intel's runtime beside another implementation is needed (scripts/with-intel)");
     TempDir dir;
     auto args = [&](const std::string& out, const std::string& device) {
-        return std::vector<std::string>{"render", kCornell, "--width", "24", "--height", "16",
-                                        "--spp", "16", "--quiet", "--out", out, "--device", device};
+        return std::vector<std::string>{"render", kCornell,   "--width", "24",      "--height",
+                                        "16",     "--spp",    "16",      "--quiet", "--out",
+                                        out,      "--device", device};
     };
     int other = -1;
     for (const auto& [name, index] : platforms)

@@ -2,8 +2,8 @@
 
 #include <CL/opencl.hpp>
 #include <algorithm>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <functional>
@@ -16,10 +16,10 @@
 #include "cl/cl_error.h"
 #include "cl/device.h"
 #include "cl/device_select.h"
-#include "render/memory_estimate.h"
 #include "cl/program.h"
 #include "common/error.h"
 #include "render/gpu_scene.h"
+#include "render/memory_estimate.h"
 #include "render/plan.h"
 #include "scene/gltf_import.h"
 

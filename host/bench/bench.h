@@ -15,10 +15,10 @@ struct BenchOptions {
     std::string scene;
     std::string rays;  // "primary", "shadow", "ambient"; empty: all three
     int width = 1024, height = 1024;
-    int repeats = 5;    // timed launches after one warm-up; the median is reported
-    int device = 0;     // index from `mcrt devices`
-    bool json = false;  // one JSON object per ray kind and line instead of a table
-    BvhBuildOptions bvh;  // SAH build options, for experiments with the tree's shape
+    int repeats = 5;               // timed launches after one warm-up; the median is reported
+    int device = 0;                // index from `mcrt devices`
+    bool json = false;             // one JSON object per ray kind and line instead of a table
+    BvhBuildOptions bvh;           // SAH build options, for experiments with the tree's shape
     std::optional<Camera> camera;  // --look-from ...: in place of the scene's camera
 };
 

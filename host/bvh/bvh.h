@@ -32,18 +32,18 @@ struct BvhStats {
     double sah_cost = 0;  // expected cost per ray, in packet tests (PBRT 4.3.2)
     int depth = 0;        // nodes on the longest root-to-leaf path, ≤ kMaxBvhDepth
     size_t inner_nodes = 0, leaves = 0;
-    size_t packets = 0;           // TrianglePackets (ceil(N / 4) per leaf of N triangles)
-    size_t bytes = 0;  // what the device holds: 4-wide nodes, packets, a TriangleInfo per lane
+    size_t packets = 0;  // TrianglePackets (ceil(N / 4) per leaf of N triangles)
+    size_t bytes = 0;    // what the device holds: 4-wide nodes, packets, a TriangleInfo per lane
     double collapse_seconds = 0;  // of build_seconds, the BVH2 → BVH4 collapse and packing
     int depth4 = 0;               // Bvh4Nodes on the longest root-to-leaf path, ≤ kMaxBvh4Depth
     double sah_cost4 = 0;         // SAH cost of the 4-wide tree (a node visit costs traversal_cost)
 };
 
 struct Bvh {
-    std::vector<gpu::BvhNode> nodes;       // binary SAH tree; nodes[0] is the root
-    std::vector<gpu::Bvh4Node> nodes4;     // the same leaves under 4-wide nodes, for the device
+    std::vector<gpu::BvhNode> nodes;           // binary SAH tree; nodes[0] is the root
+    std::vector<gpu::Bvh4Node> nodes4;         // the same leaves under 4-wide nodes, for the device
     std::vector<gpu::TrianglePacket> packets;  // nodes4's leaves, four triangles per packet
-    std::vector<gpu::Triangle> triangles;      // in leaf order (host only: the device reads packets)
+    std::vector<gpu::Triangle> triangles;  // in leaf order (host only: the device reads packets)
     BvhStats stats;
 };
 

@@ -111,9 +111,7 @@ struct Scratch {
 // Scenes smaller than this are built on one thread: threads would cost more than they save.
 constexpr uint32_t kParallelMinTriangles = 65536;
 
-bool is_inner(const gpu::BvhNode& node) {
-    return gpu::as_uint(node.hi.w) == 0;
-}
+bool is_inner(const gpu::BvhNode& node) { return gpu::as_uint(node.hi.w) == 0; }
 
 // Moves an inner node's child index by `offset`; leaves index triangles and stay.
 gpu::BvhNode shifted(gpu::BvhNode node, uint32_t offset) {

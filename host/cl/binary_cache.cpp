@@ -1,9 +1,12 @@
 // Compiled program binaries on disk, keyed by device, driver, source and options.
 #include "cl/binary_cache.h"
 
-#include "common/environment.h"
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>  // environ
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -11,22 +14,17 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <system_error>
 #include <thread>
 #include <vector>
-
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>  // environ
-
-#include <atomic>
-#include <sstream>
 
 #include "cl/build_child.h"
 #include "cl/cl_error.h"
 #include "cl/pocl_binary.h"
 #include "cl/program.h"
 #include "common/atomic_file.h"
+#include "common/environment.h"
 #include "common/error.h"
 
 namespace mcrt {
@@ -143,8 +141,10 @@ int open_cache_file(const std::string& path, CacheName& kind, std::string& what)
     struct stat st {};
     if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
         kind = CacheName::other;
-        what = S_ISDIR(st.st_mode) ? "a directory" : S_ISFIFO(st.st_mode) ? "a FIFO"
-             : S_ISSOCK(st.st_mode) ? "a socket" : "a device or special file";
+        what = S_ISDIR(st.st_mode)    ? "a directory"
+               : S_ISFIFO(st.st_mode) ? "a FIFO"
+               : S_ISSOCK(st.st_mode) ? "a socket"
+                                      : "a device or special file";
         ::close(fd);
         return -1;
     }
@@ -206,12 +206,12 @@ void write_cache_file(const std::string& path, const std::string& bytes) {
     static std::atomic<unsigned> counter{0};
     sweep_stale_temporaries(path);  // those of writers killed before their rename
     const fs::path target(path);
-    const std::string temporary = (target.parent_path() /
-                                   ("." + target.filename().string() + ".tmp-" +
-                                    std::to_string(::getpid()) + "-" + std::to_string(counter++)))
-                                      .string();
-    const int fd = ::open(temporary.c_str(),
-                          O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    const std::string temporary =
+        (target.parent_path() / ("." + target.filename().string() + ".tmp-" +
+                                 std::to_string(::getpid()) + "-" + std::to_string(counter++)))
+            .string();
+    const int fd =
+        ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
     if (fd < 0) throw RuntimeError(temporary + ": cannot create: " + std::strerror(errno));
     size_t written = 0;
     while (written < bytes.size()) {
@@ -241,7 +241,8 @@ void write_cache_file(const std::string& path, const std::string& bytes) {
     if (::rename(temporary.c_str(), path.c_str()) != 0) {
         const int error = errno;
         ::unlink(temporary.c_str());
-        throw RuntimeError(path + ": cannot rename the new entry into place: " + std::strerror(error));
+        throw RuntimeError(path +
+                           ": cannot rename the new entry into place: " + std::strerror(error));
     }
 }
 
@@ -487,7 +488,8 @@ cl::Program build_program_cached(const cl::Context& context, const cl::Device& d
     const std::vector<unsigned char> whole =
         whole_binary(program, context, device, info, source, options, in_child, problem);
     r.store_error = problem.empty() ? store_binary_cache_entry(r.path, key, whole) : problem;
-    if (store_after_misses > 1 && r.store_error.empty()) ::unlink(counter.c_str());  // the name only
+    if (store_after_misses > 1 && r.store_error.empty())
+        ::unlink(counter.c_str());  // the name only
     r.seconds = seconds_since(t0);
     return program;
 }

@@ -18,11 +18,10 @@
 // skipped.
 #pragma once
 
+#include <CL/opencl.hpp>
 #include <cstdint>
 #include <string>
 #include <vector>
-
-#include <CL/opencl.hpp>
 
 #include "cl/device.h"
 
@@ -58,11 +57,11 @@ std::string store_binary_cache_entry(const std::string& path, const BinaryCacheK
 
 // What build_program_cached did.
 struct BuildReport {
-    bool cache_hit = false;   // built from a cached binary
-    double seconds = 0;       // wall time of the whole call
-    std::string path;         // the entry's file; empty when the cache is disabled
-    std::string rejected;     // why an existing entry was not used (corrupt, driver refused)
-    std::string store_error;  // why the entry could not be written; empty when written or hit
+    bool cache_hit = false;       // built from a cached binary
+    double seconds = 0;           // wall time of the whole call
+    std::string path;             // the entry's file; empty when the cache is disabled
+    std::string rejected;         // why an existing entry was not used (corrupt, driver refused)
+    std::string store_error;      // why the entry could not be written; empty when written or hit
     bool store_deferred = false;  // a miss counted, not stored (store_after_misses)
 };
 

@@ -1,7 +1,5 @@
 #include "cl/build_child.h"
 
-#include "common/environment.h"
-
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/prctl.h>
@@ -20,6 +18,7 @@
 
 #include "cl/binary_cache.h"
 #include "cl/program.h"
+#include "common/environment.h"
 #include "common/signal_name.h"
 #include "common/test_hooks.h"
 
@@ -69,7 +68,8 @@ void sweep_stale_build_directories(const fs::path& parent) {
         const pid_t owner = build_directory_owner(it->path().filename().string());
         if (owner <= 0 || owner == ::getpid()) continue;
         struct stat st {};
-        if (::lstat(it->path().c_str(), &st) != 0 || !S_ISDIR(st.st_mode) || st.st_uid != ::getuid())
+        if (::lstat(it->path().c_str(), &st) != 0 || !S_ISDIR(st.st_mode) ||
+            st.st_uid != ::getuid())
             continue;
         if (::kill(owner, 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to ask
         std::error_code ignored;
@@ -133,8 +133,8 @@ const std::string& build_child_executable() {
         if (ec) return std::string();
         if (self.filename() == "mcrt") return self.string();
         // A test executable in build/tests/ finds build/mcrt.
-        for (const fs::path& candidate : {self.parent_path() / "mcrt",
-                                          self.parent_path().parent_path() / "mcrt"})
+        for (const fs::path& candidate :
+             {self.parent_path() / "mcrt", self.parent_path().parent_path() / "mcrt"})
             if (fs::is_regular_file(candidate, ec) && ::access(candidate.c_str(), X_OK) == 0)
                 return candidate.string();
         return std::string();
@@ -152,8 +152,7 @@ std::vector<unsigned char> build_binary_in_child(const DeviceInfo& device,
     const std::string index = std::to_string(device.index);
     const std::string dir_text = dir.path.string();
     const std::string log = (dir.path / "log").string();
-    std::vector<char*> argv = {const_cast<char*>(exe.c_str()),
-                               const_cast<char*>("build-program"),
+    std::vector<char*> argv = {const_cast<char*>(exe.c_str()), const_cast<char*>("build-program"),
                                const_cast<char*>(dir_text.c_str()),
                                const_cast<char*>(index.c_str()), nullptr};
 
@@ -184,7 +183,8 @@ std::vector<unsigned char> build_binary_in_child(const DeviceInfo& device,
     for (;;) {
         pid_t done = ::waitpid(pid, &status, WNOHANG);
         if (done == pid) break;
-        if (done < 0 && errno != EINTR) throw RuntimeError("waitpid: " + std::string(std::strerror(errno)));
+        if (done < 0 && errno != EINTR)
+            throw RuntimeError("waitpid: " + std::string(std::strerror(errno)));
         if (g_stop_flag && *g_stop_flag) {
             ::kill(pid, SIGKILL);
             while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
@@ -213,10 +213,9 @@ std::vector<unsigned char> build_binary_in_child(const DeviceInfo& device,
     }
     std::string error = read_text(dir.path / "error");
     if (error.empty())
-        throw CompilerCrash("the kernel build for device " + std::to_string(device.index) +
-                            " ('" + device.name + "') exited with status " +
-                            std::to_string(code) + " and no word (" + variant + "): " +
-                            last_line(read_text(log)));
+        throw CompilerCrash("the kernel build for device " + std::to_string(device.index) + " ('" +
+                            device.name + "') exited with status " + std::to_string(code) +
+                            " and no word (" + variant + "): " + last_line(read_text(log)));
     throw RuntimeError(error);
 }
 
@@ -253,8 +252,9 @@ int run_build_program_child(const std::string& dir_text, int device_index) {
             std::signal(SIGSEGV, SIG_DFL);  // past a sanitizer's handler: die of the signal
             std::raise(SIGSEGV);
         }
-        cl::Program program = build_program(device.context, device.info.device,
-                                            read_text(dir / "source.cl"), read_text(dir / "options"));
+        cl::Program program =
+            build_program(device.context, device.info.device, read_text(dir / "source.cl"),
+                          read_text(dir / "options"));
         std::vector<unsigned char> binary = program_binary(program, device.info.device);
         if (binary.empty()) throw std::runtime_error("the driver returned no binary");
         const fs::path partial = dir / "binary.partial";

@@ -1,9 +1,8 @@
 // OpenCL errors: every failing call raises an error naming the call, the code's name and where.
 #pragma once
 
-#include <string>
-
 #include <CL/opencl.hpp>
+#include <string>
 
 #include "common/error.h"
 
@@ -23,16 +22,15 @@ struct ClError : RuntimeError {
 }  // namespace mcrt
 
 // Checks the cl_int result of an OpenCL call (C API or Khronos C++ binding without exceptions).
-#define CL_CHECK(call)                                                              \
-    do {                                                                            \
-        cl_int mcrt_cl_status_ = (call);                                            \
-        if (mcrt_cl_status_ != CL_SUCCESS)                                          \
-            ::mcrt::throw_cl_error(#call, mcrt_cl_status_, __FILE__, __LINE__);     \
+#define CL_CHECK(call)                                                          \
+    do {                                                                        \
+        cl_int mcrt_cl_status_ = (call);                                        \
+        if (mcrt_cl_status_ != CL_SUCCESS)                                      \
+            ::mcrt::throw_cl_error(#call, mcrt_cl_status_, __FILE__, __LINE__); \
     } while (0)
 
 // Checks the error out-parameter of a constructor-style call.
-#define CL_CHECK_STATUS(status, what)                                               \
-    do {                                                                            \
-        if ((status) != CL_SUCCESS)                                                 \
-            ::mcrt::throw_cl_error(what, (status), __FILE__, __LINE__);             \
+#define CL_CHECK_STATUS(status, what)                                                           \
+    do {                                                                                        \
+        if ((status) != CL_SUCCESS) ::mcrt::throw_cl_error(what, (status), __FILE__, __LINE__); \
     } while (0)

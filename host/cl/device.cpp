@@ -14,7 +14,8 @@ std::string DeviceInfo::type_name() const {
 }
 
 bool DeviceInfo::ieee_basic_operations() const {
-    return (single_fp_config & CL_FP_DENORM) && (single_fp_config & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT);
+    return (single_fp_config & CL_FP_DENORM) &&
+           (single_fp_config & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT);
 }
 
 template <cl_int Name, typename T>

@@ -1,12 +1,11 @@
 // OpenCL platforms and devices, and a context and queue per device.
 #pragma once
 
+#include <CL/opencl.hpp>
 #include <functional>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <CL/opencl.hpp>
 
 namespace mcrt {
 
@@ -18,8 +17,9 @@ struct DeviceInfo {
     cl_device_type type = 0;
     cl_ulong global_memory = 0, max_allocation = 0;
     cl_uint compute_units = 0;
-    cl_device_fp_config single_fp_config = 0;  // CL_FP_DENORM, CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT, ...
-    bool fp64 = false;                         // cl_khr_fp64 (or OpenCL 1.2's double support)
+    cl_device_fp_config single_fp_config =
+        0;              // CL_FP_DENORM, CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT, ...
+    bool fp64 = false;  // cl_khr_fp64 (or OpenCL 1.2's double support)
 
     // Denormals kept, division and sqrt correctly rounded: the basic operations round as
     // IEEE-754 says, which bitwise agreement with other devices needs (docs/DESIGN.md).

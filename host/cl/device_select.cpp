@@ -1,12 +1,11 @@
 #include "cl/device_select.h"
 
-#include "common/activity.h"
-
 #include <algorithm>
 #include <cctype>
 #include <set>
 
 #include "cl/no_device.h"
+#include "common/activity.h"
 #include "common/error.h"
 
 namespace mcrt {
@@ -28,7 +27,9 @@ bool platform_matches(const std::string& spec, const DeviceInfo& d) {
            lower(d.platform_vendor).find(s) != std::string::npos;
 }
 
-bool is_reserved(const std::string& spec) { return spec == "all" || spec == "cpu" || spec == "gpu"; }
+bool is_reserved(const std::string& spec) {
+    return spec == "all" || spec == "cpu" || spec == "gpu";
+}
 
 }  // namespace
 
@@ -64,7 +65,8 @@ std::vector<DeviceInfo> select_devices(const std::vector<std::string>& specs,
                              "': expected a device index, cpu, gpu, all or a platform name");
         throw InputError("--device " + spec +
                          ": expected a device index, cpu, gpu, all or a platform name; no "
-                         "platform's name or vendor contains '" + spec + "' (see `mcrt devices`)");
+                         "platform's name or vendor contains '" +
+                         spec + "' (see `mcrt devices`)");
     }
     std::vector<DeviceInfo> result;
     for (int i : chosen) result.push_back(all[size_t(i)]);

@@ -1,12 +1,8 @@
 #include "cl/no_device.h"
 
-#include "common/environment.h"
-#include "common/error.h"
-#include "common/regular_file.h"
-
 #include <dlfcn.h>
-#include <sys/stat.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -17,6 +13,10 @@
 #include <sstream>
 #include <system_error>
 #include <vector>
+
+#include "common/environment.h"
+#include "common/error.h"
+#include "common/regular_file.h"
 
 namespace mcrt {
 
@@ -62,21 +62,23 @@ std::string joined(const std::vector<std::string>& items) {
 // distributions put them; else the types PoCL 3 documents ("POCL_DEVICES", PoCL's manual).
 std::vector<std::string> pocl_device_types() {
     std::set<std::string> types;
-    for (const char* dir : {"/usr/lib/x86_64-linux-gnu/pocl", "/usr/lib/aarch64-linux-gnu/pocl",
-                            "/usr/lib64/pocl", "/usr/lib/pocl", "/usr/local/lib/pocl",
-                            "/usr/local/lib64/pocl"}) {
+    for (const char* dir :
+         {"/usr/lib/x86_64-linux-gnu/pocl", "/usr/lib/aarch64-linux-gnu/pocl", "/usr/lib64/pocl",
+          "/usr/lib/pocl", "/usr/local/lib/pocl", "/usr/local/lib64/pocl"}) {
         std::error_code ec;
         for (const auto& entry : fs::directory_iterator(dir, ec)) {
             const std::string name = entry.path().filename().string();
             const std::string prefix = "libpocl-devices-", suffix = ".so";
             if (name.size() > prefix.size() + suffix.size() && name.rfind(prefix, 0) == 0 &&
                 name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0)
-                types.insert(name.substr(prefix.size(), name.size() - prefix.size() - suffix.size()));
+                types.insert(
+                    name.substr(prefix.size(), name.size() - prefix.size() - suffix.size()));
         }
     }
     types.insert("basic");  // built into libpocl where it has no module
     if (types.size() == 1)
-        types.insert({"pthread", "tbb", "cuda", "hsa", "level0", "vulkan", "almaif", "remote", "proxy"});
+        types.insert(
+            {"pthread", "tbb", "cuda", "hsa", "level0", "vulkan", "almaif", "remote", "proxy"});
     return {types.begin(), types.end()};
 }
 
@@ -90,8 +92,10 @@ std::string pocl_devices_problem() {
     std::vector<std::string> unknown;
     bool any_known = false;
     while (words >> word) {
-        if (std::find(known.begin(), known.end(), word) != known.end()) any_known = true;
-        else unknown.push_back(word);
+        if (std::find(known.begin(), known.end(), word) != known.end())
+            any_known = true;
+        else
+            unknown.push_back(word);
     }
     if (any_known) return {};
     return std::string("POCL_DEVICES='") + value + "' names " +
@@ -170,15 +174,15 @@ void check_icd_files() {
         const std::string problem = icd_file_problem(file);
         if (problem.empty()) continue;
         const char* vendors = environment(kEnvOclIcdVendors);
-        throw RuntimeError("the OpenCL ICD file " + file.string() + " " + problem +
-                           "; remove it" +
-                           (vendors && *vendors ? ", or set OCL_ICD_VENDORS to a directory without it"
-                                                : ""));
+        throw RuntimeError(
+            "the OpenCL ICD file " + file.string() + " " + problem + "; remove it" +
+            (vendors && *vendors ? ", or set OCL_ICD_VENDORS to a directory without it" : ""));
     }
 }
 
 std::string no_device_message() {
-    for (const std::string& problem : {pocl_devices_problem(), pocl_cache_problem(), icd_load_problem()})
+    for (const std::string& problem :
+         {pocl_devices_problem(), pocl_cache_problem(), icd_load_problem()})
         if (!problem.empty()) return "no OpenCL device found: " + problem;
     return "no OpenCL device found (is an ICD such as PoCL installed?)" + address_space_limit();
 }

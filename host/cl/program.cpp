@@ -1,19 +1,18 @@
 #include "cl/program.h"
 
-#include "common/environment.h"
-
 #include <cstdlib>
 #include <fstream>
 #include <map>
 #include <mutex>
-#include <tuple>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "cl/binary_cache.h"
 #include "cl/build_child.h"
 #include "cl/cl_error.h"
 #include "cl/no_device.h"
+#include "common/environment.h"
 
 namespace mcrt {
 
@@ -127,7 +126,8 @@ std::string device_program_options(const DeviceInfo& device) {
 }
 
 cl::Program cached_program(const DeviceContext& device, const std::string& file,
-                           const std::string& given_options, const KernelReplacements& replacements) {
+                           const std::string& given_options,
+                           const KernelReplacements& replacements) {
     const std::string options = given_options + device_program_options(device.info);
     // Keyed by the context handle: the cached program holds a reference to its context, so the
     // handle cannot be freed and reused while the entry exists.
@@ -147,17 +147,16 @@ cl::Program cached_program(const DeviceContext& device, const std::string& file,
     // the binary is stored at a variant's third build only: one built once or twice (most of a
     // test suite's) never pays for it.
     const char* pocl_cache = environment(kEnvPoclKernelCache);
-    bool driver_caches = device.info.platform_name.find("Portable Computing Language") !=
-                             std::string::npos &&
-                         !(pocl_cache && std::string(pocl_cache) == "0");
+    bool driver_caches =
+        device.info.platform_name.find("Portable Computing Language") != std::string::npos &&
+        !(pocl_cache && std::string(pocl_cache) == "0");
     // Where the binary is stored at the first build anyway, the build runs in a child process
     // (build_child.h): a vendor compiler's crash then costs the device, not mcrt. PoCL's builds
     // stay in this process: asking it for the binary costs a second code generation.
     const bool in_child = !driver_caches && !build_child_executable().empty();
-    cl::Program program = build_program_cached(device.context, device.info.device, device.info,
-                                               source, options, nullptr,
-                                               driver_caches ? kDriverCachesStoreAfterMisses : 1,
-                                               in_child);
+    cl::Program program =
+        build_program_cached(device.context, device.info.device, device.info, source, options,
+                             nullptr, driver_caches ? kDriverCachesStoreAfterMisses : 1, in_child);
     programs.emplace(key, program);
     return program;
 }

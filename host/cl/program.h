@@ -1,10 +1,9 @@
 // OpenCL program sources (embedded or from disk) and their compilation.
 #pragma once
 
+#include <CL/opencl.hpp>
 #include <map>
 #include <string>
-
-#include <CL/opencl.hpp>
 
 #include "cl/device.h"
 
@@ -33,9 +32,9 @@ cl::Program build_program(const cl::Context& context, const cl::Device& device,
 // devices agree bit for bit, and workarounds for a vendor's compiler.
 std::string device_program_options(const DeviceInfo& device);
 
-// build_program(kernel_source(file), options + device_program_options) for the device, built once per process and kept:
-// every specialised variant (-D options) is compiled once, however many renders use it.
-// Thread-safe.
+// build_program(kernel_source(file), options + device_program_options) for the device, built once
+// per process and kept: every specialised variant (-D options) is compiled once, however many
+// renders use it. Thread-safe.
 cl::Program cached_program(const DeviceContext& device, const std::string& file,
                            const std::string& options, const KernelReplacements& replacements = {});
 

@@ -5,8 +5,8 @@
 
 #include <CLI/CLI.hpp>
 #include <cerrno>
-#include <cstring>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <iostream>
 #include <system_error>
@@ -69,13 +69,11 @@ int run_devices() {
         if (!(d.single_fp_config & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT))
             caveats += std::string(caveats.empty() ? "" : ", ") +
                        "does not promise correctly rounded division and sqrt";
-        if (!caveats.empty())
-            caveats = " (" + caveats + ": the agreement check guards its images)";
-        std::printf("%d: %s [%s] — %s (%s), %s, %u compute units, %.1f GiB, driver %s%s\n",
-                    d.index, d.name.c_str(), d.type_name().c_str(), d.platform_name.c_str(),
+        if (!caveats.empty()) caveats = " (" + caveats + ": the agreement check guards its images)";
+        std::printf("%d: %s [%s] — %s (%s), %s, %u compute units, %.1f GiB, driver %s%s\n", d.index,
+                    d.name.c_str(), d.type_name().c_str(), d.platform_name.c_str(),
                     d.platform_vendor.c_str(), d.version.c_str(), d.compute_units,
-                    double(d.global_memory) / (1 << 30), d.driver_version.c_str(),
-                    caveats.c_str());
+                    double(d.global_memory) / (1 << 30), d.driver_version.c_str(), caveats.c_str());
     }
     return 0;
 }

@@ -9,8 +9,8 @@
 
 #include "cl/cl_error.h"
 #include "cl/device_select.h"
-#include "cli/messages.h"
 #include "cl/program.h"
+#include "cli/messages.h"
 #include "common/atomic_file.h"
 #include "common/error.h"
 
@@ -113,8 +113,9 @@ IntegrateRow summarize(const std::string& estimator, int64_t n, const std::vecto
 std::vector<IntegrateRow> integrate_cosine_hemisphere(const DeviceContext& device,
                                                       const IntegrateOptions& o) {
     check_options(o);
-    cl::Program program = build_program(device.context, device.info.device,
-                                        kernel_source("integrate.cl"), "-cl-std=CL1.2 -D SAMPLER_INDEPENDENT");
+    cl::Program program =
+        build_program(device.context, device.info.device, kernel_source("integrate.cl"),
+                      "-cl-std=CL1.2 -D SAMPLER_INDEPENDENT");
     const uint32_t repeats = uint32_t(o.repeats);
     const int64_t largest = *std::max_element(o.n.begin(), o.n.end());
     cl::Buffer samples = device_buffer(

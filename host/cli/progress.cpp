@@ -1,18 +1,22 @@
 #include "cli/progress.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <string>
-
-#include <unistd.h>
 
 namespace mcrt {
 
 bool stderr_is_terminal() { return ::isatty(STDERR_FILENO) == 1; }
 
 ProgressBar::ProgressBar(bool enabled, uint64_t samples_per_spp, bool redraw, std::FILE* out)
-    : enabled_(enabled), samples_per_spp_(samples_per_spp), redraw_(redraw), out_(out),
-      start_(std::chrono::steady_clock::now()), last_(start_) {}
+    : enabled_(enabled),
+      samples_per_spp_(samples_per_spp),
+      redraw_(redraw),
+      out_(out),
+      start_(std::chrono::steady_clock::now()),
+      last_(start_) {}
 
 double progress_fraction(uint32_t done, uint32_t total, uint64_t samples_per_spp,
                          const std::vector<DeviceReport>& devices) {
@@ -83,13 +87,14 @@ void ProgressBar::update(uint32_t done, uint32_t total, const std::vector<Device
         for (const DeviceReport& d : devices) {
             char share[48];
             std::snprintf(share, sizeof share, " d%d:%d%%%s", d.index,
-                          all ? int(100.0 * d.samples / all + 0.5) : 0, d.retired ? "(retired)" : "");
+                          all ? int(100.0 * d.samples / all + 0.5) : 0,
+                          d.retired ? "(retired)" : "");
             shares += share;
         }
     }
-    std::fprintf(out_, "%s[%s] %3d%% %u/%u spp  %.2f Msamples/s  %s s left%s%s", redraw_ ? "\r" : "",
-                 bar, int(fraction * 100 + 0.5), done, total, rate * 1e-6, left, shares.c_str(),
-                 redraw_ ? " " : "\n");
+    std::fprintf(out_, "%s[%s] %3d%% %u/%u spp  %.2f Msamples/s  %s s left%s%s",
+                 redraw_ ? "\r" : "", bar, int(fraction * 100 + 0.5), done, total, rate * 1e-6,
+                 left, shares.c_str(), redraw_ ? " " : "\n");
     std::fflush(out_);
 }
 

@@ -20,7 +20,7 @@ double progress_fraction(uint32_t done, uint32_t total, uint64_t samples_per_spp
 bool stderr_is_terminal();
 
 class ProgressBar {
-public:
+  public:
     // On a terminal (`redraw`) one line redrawn in place with carriage returns; elsewhere (a log,
     // a pipe) lines of their own: the first when rendering starts, then one at each further
     // tenth of the render, at most one a second, and the last at 100%. Written to `out`.
@@ -37,7 +37,7 @@ public:
                 std::chrono::steady_clock::time_point now);
     void finish();
 
-private:
+  private:
     bool enabled_;
     uint64_t samples_per_spp_;
     bool redraw_;

@@ -1,9 +1,9 @@
 #include "cli/render_command.h"
 
 #include <cerrno>
-#include <cstdio>
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "bvh/bvh.h"
+#include "cl/build_child.h"
 #include "cl/device_select.h"
 #include "cli/messages.h"
 #include "cli/progress.h"
@@ -29,12 +30,11 @@
 #include "image/image.h"
 #include "image/image_check.h"
 #include "mpi/job.h"
-#include "render/memory_estimate.h"
 #include "render/estimator_file.h"
+#include "render/memory_estimate.h"
 #include "render/render_program.h"
 #include "render/renderer.h"
 #include "render/session.h"
-#include "cl/build_child.h"
 #include "render/variants.h"
 #include "scene/gltf_import.h"
 
@@ -52,7 +52,7 @@ struct InterruptGuard {
     InterruptGuard() {
         g_interrupted = 0;
         set_build_stop_flag(&g_interrupted);  // a kernel build in a child process stops too
-        set_stop_flag(&g_interrupted);         // so does the output commit's wait for a lock
+        set_stop_flag(&g_interrupted);        // so does the output commit's wait for a lock
         struct sigaction action {};
         action.sa_handler = on_interrupt;
         action.sa_flags = SA_RESETHAND;
@@ -124,7 +124,8 @@ void report_nonfinite_samples(uint64_t nonfinite, uint64_t samples, const Warnin
 }  // namespace
 
 void check_render_result(const RenderResult& result, const WarningSink& warn) {
-    const uint64_t samples = uint64_t(result.image.width) * uint64_t(result.image.height) * result.spp;
+    const uint64_t samples =
+        uint64_t(result.image.width) * uint64_t(result.image.height) * result.spp;
     report_nonfinite_samples(result.nan_samples, samples, warn);
     if (uint64_t bad = nonfinite_pixels(result.image))
         throw RuntimeError(std::to_string(bad) +
@@ -145,8 +146,8 @@ std::map<std::string, std::string> exr_attributes(const RenderOptions& o,
         {"mcrt.replicates", std::to_string(result.replicates)},
         {"mcrt.variance",
          result.replicates > 1
-             ? "variance of the pixel mean from the spread of " + std::to_string(result.replicates) +
-                   " independent replicate means"
+             ? "variance of the pixel mean from the spread of " +
+                   std::to_string(result.replicates) + " independent replicate means"
              : "variance of the pixel mean: the samples' variance over their number"}};
     // Only with a map: a render without one keeps its file's bytes.
     if (!o.env.empty()) attributes["mcrt.env"] = o.env;
@@ -306,17 +307,21 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
         ->capture_default_str()
         ->check(kFiniteFloat)
         ->check(CLI::Range(0.0f, 3.4e38f));
-    CLI::Option* camera = cmd->add_option("--camera", o.camera, "glTF camera index in the scene (cameras[K])")
-                              ->check(CLI::Range(0, 1 << 30));
+    CLI::Option* camera =
+        cmd->add_option("--camera", o.camera, "glTF camera index in the scene (cameras[K])")
+            ->check(CLI::Range(0, 1 << 30));
     add_camera_options(cmd, o.look, camera);
-    cmd->add_option("--device", o.devices, "device index, cpu, gpu, all or a platform such as pocl or intel (repeatable)");
+    cmd->add_option("--device", o.devices,
+                    "device index, cpu, gpu, all or a platform such as pocl or intel (repeatable)");
     cmd->add_option("--batch", o.batch, "samples per pixel per launch (0 chooses)")
         ->capture_default_str()
         ->check(CLI::Range(0u, 1u << 24));
     cmd->add_option("--replicates", o.replicates,
                     "independent randomizations of the sampler that the variance layer is "
                     "estimated from (1, 2, 4, 8, 16 dividing --spp; 0: 1 for independent samples, "
-                    "else " + std::to_string(kDefaultReplicates) + " or the largest power of two dividing --spp)")
+                    "else " +
+                        std::to_string(kDefaultReplicates) +
+                        " or the largest power of two dividing --spp)")
         ->capture_default_str()
         ->check(CLI::Range(0u, 16u));
     cmd->add_option("--stats", o.stats, "write statistics as JSON");

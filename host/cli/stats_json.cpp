@@ -57,7 +57,8 @@ nlohmann::json render_stats_json(const RenderStatsInput& in) {
         {"seconds_kernel_build", result.seconds_build},
         // Wall clock from the first launch to the last result: kernels, launch gaps, host work.
         {"seconds_render_wall", result.seconds_render_wall},
-        // From the start of the command to the first batch in the image (docs/BENCHMARKS.md, "Start-up").
+        // From the start of the command to the first batch in the image (docs/BENCHMARKS.md,
+        // "Start-up").
         {"seconds_to_first_batch", in.seconds_to_render + result.seconds_first_batch},
         {"seconds_bvh_build", bvh.stats.build_seconds},
         {"samples_per_second", result.seconds_render > 0 ? samples / result.seconds_render : 0.0},

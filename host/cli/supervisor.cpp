@@ -162,16 +162,17 @@ std::string seconds_text(double s) {
 }
 
 // "with the estimator file F (HINT)" or "(OTHER)".
-std::string estimator_hint(const WorkerStage& w, const std::string& hint, const std::string& other) {
+std::string estimator_hint(const WorkerStage& w, const std::string& hint,
+                           const std::string& other) {
     return w.estimator.empty() ? " (" + other + ")"
                                : " with the estimator file " + w.estimator + " (" + hint + ")";
 }
 
 void print_error(const WorkerStage& w, const std::string& message) {
     // The progress bar's line is left open while kernels run.
-    std::cerr << (w.stage == Stage::kLaunch && w.bar ? "\n" : "") << "mcrt: error: "
-              << (w.rank > 0 ? "rank " + std::to_string(w.rank) + ": " : "") << message
-              << std::endl;
+    std::cerr << (w.stage == Stage::kLaunch && w.bar ? "\n" : "")
+              << "mcrt: error: " << (w.rank > 0 ? "rank " + std::to_string(w.rank) + ": " : "")
+              << message << std::endl;
 }
 
 // Where a worker that did not stop within the grace period (`of_what`: after what) was stuck.
@@ -435,8 +436,8 @@ std::optional<int> supervise_command(int argc, char** argv) {
     // Its own process group: a terminal's Ctrl-C reaches the supervisor alone, which forwards it
     // once. SIGINT and SIGTERM at their default actions (a forwarded one ends a worker that has
     // not caught it yet); SIGHUP as it was (ignored under nohup).
-    posix_spawnattr_setflags(&attributes,
-                             POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
+    posix_spawnattr_setflags(
+        &attributes, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
     posix_spawnattr_setpgroup(&attributes, 0);
     sigset_t none, defaults;
     sigemptyset(&none);
@@ -446,7 +447,8 @@ std::optional<int> supervise_command(int argc, char** argv) {
     sigaddset(&defaults, SIGTERM);
     posix_spawnattr_setsigdefault(&attributes, &defaults);
     pid_t pid = 0;
-    const int spawned = posix_spawn(&pid, "/proc/self/exe", nullptr, &attributes, argv, envp.data());
+    const int spawned =
+        posix_spawn(&pid, "/proc/self/exe", nullptr, &attributes, argv, envp.data());
     posix_spawnattr_destroy(&attributes);
     ::close(fds[1]);
     if (spawned != 0) {  // render in this process, as without a supervisor

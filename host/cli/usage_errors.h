@@ -2,9 +2,8 @@
 // `mcrt frobnicate`, which hides the word actually typed.
 #pragma once
 
-#include <string>
-
 #include <CLI/CLI.hpp>
+#include <string>
 
 namespace mcrt {
 

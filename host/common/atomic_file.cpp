@@ -160,11 +160,11 @@ class DirectoryLocks {
 }  // namespace
 
 struct OutputSet::Output {
-    std::string option, path;   // as given
-    fs::path target;            // after its links: what the commit replaces
-    int fd = -1;                // the unnamed temporary, or -1
-    std::string temporary;      // what the writer opens: /proc/self/fd/N or the named sibling
-    fs::path linked;            // the name the temporary has during the commit
+    std::string option, path;  // as given
+    fs::path target;           // after its links: what the commit replaces
+    int fd = -1;               // the unnamed temporary, or -1
+    std::string temporary;     // what the writer opens: /proc/self/fd/N or the named sibling
+    fs::path linked;           // the name the temporary has during the commit
 
     std::string name() const { return option.empty() ? path : option + " " + path; }
 
@@ -221,8 +221,8 @@ void OutputSet::prepare(const std::vector<std::string>& inputs) {
         if (fd < 0) {
             const int error = errno;
             discard();
-            throw InputError(output.name() + ": cannot create a file in " +
-                             directory.string() + ": " + std::strerror(error));
+            throw InputError(output.name() + ": cannot create a file in " + directory.string() +
+                             ": " + std::strerror(error));
         }
         ::close(fd);
         output.temporary = named.string();
@@ -239,7 +239,8 @@ const std::string& OutputSet::temporary(const std::string& path) const {
 void OutputSet::commit() {
     if (!prepared_) throw RuntimeError("output set committed before it was prepared");
     std::vector<std::string> directories;
-    for (const auto& output : outputs_) directories.push_back(directory_of(output->target).string());
+    for (const auto& output : outputs_)
+        directories.push_back(directory_of(output->target).string());
     test_pause("write");
     try {
         DirectoryLocks locks(directories);
@@ -248,7 +249,8 @@ void OutputSet::commit() {
         for (const auto& output : outputs_) {
             struct stat st {};
             if (::stat(output->target.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
-                throw RuntimeError(output->name() + ": became something else than a regular file; not replaced");
+                throw RuntimeError(output->name() +
+                                   ": became something else than a regular file; not replaced");
             }
             if (output->fd < 0) {
                 output->linked = output->temporary;
@@ -258,15 +260,17 @@ void OutputSet::commit() {
             if (::linkat(AT_FDCWD, output->temporary.c_str(), AT_FDCWD, hidden.c_str(),
                          AT_SYMLINK_FOLLOW) != 0) {
                 throw RuntimeError(output->name() + ": cannot link the written file into " +
-                                   directory_of(output->target).string() + ": " + std::strerror(errno));
+                                   directory_of(output->target).string() + ": " +
+                                   std::strerror(errno));
             }
             output->linked = hidden;
         }
         bool first = true;
         for (const auto& output : outputs_) {
             if (std::rename(output->linked.c_str(), output->target.c_str()) != 0) {
-                throw RuntimeError(output->target.string() +
-                                   ": cannot rename temporary file into place: " + std::strerror(errno));
+                throw RuntimeError(
+                    output->target.string() +
+                    ": cannot rename temporary file into place: " + std::strerror(errno));
             }
             output->linked.clear();
             if (output->fd < 0) output->temporary.clear();  // it is the target now
@@ -295,8 +299,8 @@ int sweep_stale_temporaries(const std::string& path) {
     for (fs::directory_iterator it(directory, ec), end; !ec && it != end; it.increment(ec)) {
         const pid_t owner = temporary_owner(it->path().filename().string(), name);
         if (owner == 0 || owner == ::getpid()) continue;
-        // Alive (or not ours to signal, EPERM): keep. Only a PID that names no process, or a zombie,
-        // is stale.
+        // Alive (or not ours to signal, EPERM): keep. Only a PID that names no process, or a
+        // zombie, is stale.
         if ((::kill(owner, 0) == 0 || errno != ESRCH) && !is_zombie(owner)) continue;
         std::error_code remove_ec;
         if (fs::remove(it->path(), remove_ec)) ++removed;

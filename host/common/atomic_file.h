@@ -62,7 +62,8 @@ class OutputSet {
 // Calls write(temporary_path) for a temporary beside `path`'s final target, then renames it onto
 // that target: an OutputSet of one. If write throws, the temporary is removed and the exception
 // propagates. An existing `path` that is not a regular file is never replaced (InputError).
-void write_atomically(const std::string& path, const std::function<void(const std::string&)>& write);
+void write_atomically(const std::string& path,
+                      const std::function<void(const std::string&)>& write);
 
 // Removes `.NAME.tmp-PID-N` siblings of `path` left by processes that no longer exist; returns
 // how many were removed.

@@ -58,9 +58,7 @@ const std::vector<EnvironmentEntry> kEnvironment = {
     {kEnvPmiSize, "PMI_SIZE", "read", "set by PMI launchers: mcrt joins the MPI job"},
 };
 
-const char* environment(EnvironmentVariable v) {
-    return std::getenv(kEnvironment[size_t(v)].name);
-}
+const char* environment(EnvironmentVariable v) { return std::getenv(kEnvironment[size_t(v)].name); }
 
 std::string environment_value(EnvironmentVariable v) {
     const char* text = environment(v);

@@ -9,26 +9,26 @@ namespace mcrt {
 
 enum EnvironmentVariable {
     // Users and scripts.
-    kEnvCacheDir,         // MCRT_CACHE_DIR
-    kEnvNoKernelCache,    // MCRT_NO_KERNEL_CACHE
-    kEnvMpiTimeout,       // MCRT_MPI_TIMEOUT
-    kEnvNoSupervisor,     // MCRT_NO_SUPERVISOR
+    kEnvCacheDir,       // MCRT_CACHE_DIR
+    kEnvNoKernelCache,  // MCRT_NO_KERNEL_CACHE
+    kEnvMpiTimeout,     // MCRT_MPI_TIMEOUT
+    kEnvNoSupervisor,   // MCRT_NO_SUPERVISOR
     // Development overrides.
-    kEnvKernelDir,        // MCRT_KERNEL_DIR
-    kEnvKernelOptions,    // MCRT_KERNEL_OPTIONS
-    kEnvBuildChild,       // MCRT_BUILD_CHILD
+    kEnvKernelDir,      // MCRT_KERNEL_DIR
+    kEnvKernelOptions,  // MCRT_KERNEL_OPTIONS
+    kEnvBuildChild,     // MCRT_BUILD_CHILD
     // Set by mcrt for its own child process.
-    kEnvSupervised,       // MCRT_SUPERVISED
+    kEnvSupervised,  // MCRT_SUPERVISED
     // Test hooks (common/test_hooks.h).
-    kEnvTestPause,        // MCRT_TEST_PAUSE
-    kEnvTestPauseSeconds, // MCRT_TEST_PAUSE_SECONDS
-    kEnvTestPauseUntil,   // MCRT_TEST_PAUSE_UNTIL
-    kEnvTestNoTmpfile,    // MCRT_TEST_NO_TMPFILE
-    kEnvTestWrongDevice,  // MCRT_TEST_WRONG_DEVICE
-    kEnvTestCompilerCrash,  // MCRT_TEST_COMPILER_CRASH
-    kEnvTestContextFailure, // MCRT_TEST_CONTEXT_FAILURE
-    kEnvFaultInject,      // MCRT_FAULT_INJECT
-    kEnvSlowDevice,       // MCRT_SLOW_DEVICE
+    kEnvTestPause,           // MCRT_TEST_PAUSE
+    kEnvTestPauseSeconds,    // MCRT_TEST_PAUSE_SECONDS
+    kEnvTestPauseUntil,      // MCRT_TEST_PAUSE_UNTIL
+    kEnvTestNoTmpfile,       // MCRT_TEST_NO_TMPFILE
+    kEnvTestWrongDevice,     // MCRT_TEST_WRONG_DEVICE
+    kEnvTestCompilerCrash,   // MCRT_TEST_COMPILER_CRASH
+    kEnvTestContextFailure,  // MCRT_TEST_CONTEXT_FAILURE
+    kEnvFaultInject,         // MCRT_FAULT_INJECT
+    kEnvSlowDevice,          // MCRT_SLOW_DEVICE
     // Set by others, read by mcrt.
     kEnvPoclKernelCache,  // POCL_KERNEL_CACHE
     kEnvPoclCacheDir,     // POCL_CACHE_DIR

@@ -72,7 +72,9 @@ std::string resolve_output(const std::string& option, const std::string& path) {
         if (links == kMaxLinks) throw InputError(name + ": too many levels of symbolic links");
         std::error_code ec;
         const fs::path next = fs::read_symlink(current, ec);
-        if (ec) throw InputError(name + ": cannot read the link " + current.string() + ": " + ec.message());
+        if (ec)
+            throw InputError(name + ": cannot read the link " + current.string() + ": " +
+                             ec.message());
         current = next.is_absolute() ? next : current.parent_path() / next;
     }
     const fs::path dir = current.parent_path();

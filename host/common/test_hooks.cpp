@@ -1,7 +1,5 @@
 #include "common/test_hooks.h"
 
-#include "common/environment.h"
-
 #include <unistd.h>
 
 #include <algorithm>
@@ -10,6 +8,8 @@
 #include <cstring>
 #include <string>
 #include <thread>
+
+#include "common/environment.h"
 
 namespace mcrt {
 
@@ -50,8 +50,7 @@ uint64_t test_fault_launch(int device) {
 
 double test_slow_factor(int device) {
     double factor = 1;
-    return environment_device_value(kEnvSlowDevice, device, &factor) ? std::max(1.0, factor)
-                                                                      : 1.0;
+    return environment_device_value(kEnvSlowDevice, device, &factor) ? std::max(1.0, factor) : 1.0;
 }
 
 }  // namespace mcrt

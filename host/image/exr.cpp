@@ -71,7 +71,8 @@ void write_exr_file(const std::string& temporary, const std::string& path, const
         file.writePixels(image.height);
     }
     stream.close();
-    if (stream.fail()) throw RuntimeError(path + ": write failed: " + std::strerror(errno ? errno : EIO));
+    if (stream.fail())
+        throw RuntimeError(path + ": write failed: " + std::strerror(errno ? errno : EIO));
 }
 
 }  // namespace

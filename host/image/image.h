@@ -14,7 +14,8 @@ struct Image {
     double spp = 0;               // samples per pixel
 
     Image() = default;
-    Image(int w, int h) : width(w), height(h), rgb(3 * size_t(w) * h), variance(3 * size_t(w) * h) {}
+    Image(int w, int h)
+        : width(w), height(h), rgb(3 * size_t(w) * h), variance(3 * size_t(w) * h) {}
 };
 
 // EXR with float32 channels R, G, B, variance.R, variance.G, variance.B and a float header

@@ -342,8 +342,8 @@ int serve_render(const std::function<RenderRequest()>& make_request,
         for (const DeviceInfo& d : devices) {
             try {
                 contexts.push_back(std::make_unique<DeviceContext>(d));
-                workers.push_back(
-                    std::make_unique<DeviceWorker>(*contexts.back(), render.scene.gpu, render.plan));
+                workers.push_back(std::make_unique<DeviceWorker>(*contexts.back(), render.scene.gpu,
+                                                                 render.plan));
             } catch (const std::exception& e) {
                 warn("skipping device " + std::to_string(d.index) + " ('" + d.name +
                      "'): " + e.what());

@@ -18,6 +18,8 @@ void RenderJob::share_inputs(const FileBundle&, const std::string&) {}
 RemoteWorkers RenderJob::remote_workers(std::function<void(const std::string&)>) { return {}; }
 nlohmann::json RenderJob::ranks_json(const std::vector<DeviceReport>&) const { return {}; }
 void RenderJob::finish(int, const std::string&) {}
-int serve_render(const std::function<RenderRequest()>&, const std::vector<std::string>&) { throw RuntimeError("mcrt was built without MPI"); }
+int serve_render(const std::function<RenderRequest()>&, const std::vector<std::string>&) {
+    throw RuntimeError("mcrt was built without MPI");
+}
 
 }  // namespace mcrt

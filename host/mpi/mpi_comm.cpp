@@ -1,7 +1,5 @@
 #include "mpi/mpi_comm.h"
 
-#include "common/environment.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
@@ -9,6 +7,7 @@
 #include <string>
 #include <thread>
 
+#include "common/environment.h"
 #include "common/error.h"
 
 namespace mcrt::mpi {

@@ -51,10 +51,9 @@ BatchResult RemoteWorker::run(const WorkItem& item) {
         traffic_->lost = true;
         const double waited =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        throw RuntimeError("rank " + std::to_string(rank_) + " sent nothing for " +
-                           std::to_string(int(waited)) + " s" +
-                           (cut_by_stop ? " after the render stopped" : "") +
-                           " and is taken for dead");
+        throw RuntimeError(
+            "rank " + std::to_string(rank_) + " sent nothing for " + std::to_string(int(waited)) +
+            " s" + (cut_by_stop ? " after the render stopped" : "") + " and is taken for dead");
     }
     const wire::Bytes& reply = *received;
     double round_trip =

@@ -11,9 +11,13 @@
 namespace mcrt {
 
 Accumulator::Accumulator(uint32_t pixels, uint32_t spp, uint32_t replicates)
-    : pixels_(pixels), spp_(spp), replicates_(replicates),
-      mean_(3 * size_t(pixels) * replicates), m2_(replicates == 1 ? 3 * size_t(pixels) : 0),
-      row_mean_(mean_.size()), row_m2_(m2_.size()) {}
+    : pixels_(pixels),
+      spp_(spp),
+      replicates_(replicates),
+      mean_(3 * size_t(pixels) * replicates),
+      m2_(replicates == 1 ? 3 * size_t(pixels) : 0),
+      row_mean_(mean_.size()),
+      row_m2_(m2_.size()) {}
 
 void Accumulator::submit(BatchResult result) {
     uint64_t seq = result.item.seq;
@@ -54,7 +58,8 @@ void for_pixel_ranges(size_t count, const Body& body) {
     const size_t step = (count + parts - 1) / parts;
     try {
         for (size_t begin = step; begin < count; begin += step)
-            threads.emplace_back([&body, begin, step, count] { body(begin, std::min(count, begin + step)); });
+            threads.emplace_back(
+                [&body, begin, step, count] { body(begin, std::min(count, begin + step)); });
     } catch (const std::system_error&) {
         // No thread to be had (a process limit): the parts not started run here.
         for (size_t begin = step * (threads.size() + 1); begin < count; begin += step)
@@ -95,7 +100,8 @@ void Accumulator::apply(const BatchResult& r) {
                         row_mean_[at + ch] = double(shift[ch]) + double(sum[ch]) * scale / n;
                         if (K == 1) {
                             const double d = double(sum[ch]);
-                            row_m2_[at + ch] = std::max(0.0, double(sum_sq[ch]) - d * d / n) * scale * scale;
+                            row_m2_[at + ch] =
+                                std::max(0.0, double(sum_sq[ch]) - d * d / n) * scale * scale;
                         }
                     }
                     part.n = n;  // the same for every pixel of a row: its chunk, over K

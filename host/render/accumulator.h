@@ -27,7 +27,7 @@ struct BatchResult {
 // update from the runs' shifted, scaled sums: nothing cancels, nothing overflows. Not
 // thread-safe: the caller locks.
 class Accumulator {
-public:
+  public:
     Accumulator(uint32_t pixels, uint32_t spp, uint32_t replicates);
     void submit(BatchResult result);
     uint32_t committed_spp() const;  // samples per pixel in the image so far
@@ -45,7 +45,7 @@ public:
     // [(p · replicates + k) · 3 + c]; empty with one replicate.
     std::vector<float> replicate_means() const;
 
-private:
+  private:
     void apply(const BatchResult& r);
     void commit_row();
 
@@ -57,8 +57,8 @@ private:
     double n_ = 0;  // samples per replicate committed, the same for every pixel
     // The chunk row being filled: per (pixel, replicate) its run's mean and squared deviations.
     std::vector<double> row_mean_, row_m2_;
-    double row_n_ = 0;          // samples per replicate in the row's runs
-    uint32_t row_pixels_ = 0;   // pixels of that row applied so far
+    double row_n_ = 0;         // samples per replicate in the row's runs
+    uint32_t row_pixels_ = 0;  // pixels of that row applied so far
     uint64_t row_nan_ = 0, row_rays_ = 0, row_vertices_ = 0, row_roulette_ = 0;
     uint32_t committed_chunks_ = 0;
     uint64_t nan_samples_ = 0, rays_ = 0, path_vertices_ = 0, roulette_ends_ = 0;

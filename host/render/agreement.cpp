@@ -82,7 +82,9 @@ void check_agreement(std::vector<std::unique_ptr<RenderWorker>>& workers, size_t
     for (size_t i = 0; i < count; ++i) {
         if (!results[i]) {
             workers[i]->report.retired = true;
-            if (warn) warn(name(i) + " failed and is retired; its work is redone on the other devices: " + failures[i]);
+            if (warn)
+                warn(name(i) + " failed and is retired; its work is redone on the other devices: " +
+                     failures[i]);
             continue;
         }
         if (same(i, winner)) continue;
@@ -96,15 +98,14 @@ void check_agreement(std::vector<std::unique_ptr<RenderWorker>>& workers, size_t
         while (k < floats && std::memcmp(a + k, b + k, sizeof(float)) == 0) ++k;
         const size_t per_run = sizeof(gpu::ChunkSums) / sizeof(float);
         const uint32_t pixel = item.pixel_begin + uint32_t(k / per_run / settings.replicates);
-        std::string where =
-            k < floats ? "at pixel (" + std::to_string(pixel % uint32_t(settings.width)) + ", " +
-                             std::to_string(pixel / uint32_t(settings.width)) + "), " +
-                             hex_float(a[k]) + " against " + hex_float(b[k])
-                       : "in the number of values";
+        std::string where = k < floats
+                                ? "at pixel (" + std::to_string(pixel % uint32_t(settings.width)) +
+                                      ", " + std::to_string(pixel / uint32_t(settings.width)) +
+                                      "), " + hex_float(a[k]) + " against " + hex_float(b[k])
+                                : "in the number of values";
         if (warn)
             warn(name(i) + " disagrees with " + name(winner) +
-                 " on the samples every device renders first (" + where +
-                 "): retired; " + kept);
+                 " on the samples every device renders first (" + where + "): retired; " + kept);
     }
 }
 

@@ -126,9 +126,9 @@ void DeviceWorker::set_up(const RenderPlan& plan) {
         CL_CHECK_STATUS(status, "clCreateBuffer(environment map)");
     }
     // Samples and, at 16 samples a chunk, their runs' sums (grown on demand when spp < 16).
-    uint64_t needed = buffers_->bytes + env_bytes + max_samples_ * sizeof(gpu::float4) +
-                      (max_samples_ / MCRT_SAMPLES_PER_CHUNK + 1) * settings.replicates *
-                          sizeof(gpu::ChunkSums);
+    uint64_t needed =
+        buffers_->bytes + env_bytes + max_samples_ * sizeof(gpu::float4) +
+        (max_samples_ / MCRT_SAMPLES_PER_CHUNK + 1) * settings.replicates * sizeof(gpu::ChunkSums);
     if (needed > device.info.global_memory)
         throw RuntimeError(
             "device '" + device.info.name + "' has " + std::to_string(device.info.global_memory) +
@@ -231,8 +231,7 @@ void DeviceWorker::start(const WorkItem& item) {
             reduce_, cl::NullRange,
             cl::NDRange(round_up(uint64_t(item.pixel_count()) * chunks, kGroupSize)),
             cl::NDRange(kGroupSize), nullptr, &launch.reduce_done));
-        CL_CHECK(device_.queue.enqueueReadBuffer(sums_, CL_FALSE, 0,
-                                                 runs * sizeof(gpu::ChunkSums),
+        CL_CHECK(device_.queue.enqueueReadBuffer(sums_, CL_FALSE, 0, runs * sizeof(gpu::ChunkSums),
                                                  launch.result.sums.data(), nullptr,
                                                  &launch.read_done));
         CL_CHECK(device_.queue.flush());  // start now, not at the next blocking call

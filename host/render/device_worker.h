@@ -10,8 +10,8 @@
 #include "cl/device.h"
 #include "render/accumulator.h"
 #include "render/gpu_scene.h"
-#include "render/render_worker.h"
 #include "render/plan.h"
+#include "render/render_worker.h"
 #include "render/renderer.h"
 #include "render/work_queue.h"
 
@@ -52,7 +52,7 @@ class DeviceWorker : public RenderWorker {
     // Adds the last successful launch to the report; the caller holds the render's lock.
     void commit_report() override;
 
-private:
+  private:
     // Makes the sums buffer hold `runs` ChunkSums, reallocating when it is smaller.
     void reserve_sums(uint64_t runs);
     // The constructors' common part: the program, the batch buffers, the kernels' arguments.

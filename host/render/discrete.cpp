@@ -61,7 +61,8 @@ std::vector<float> build_cdf(const std::vector<double>& weights) {
         });
         const int64_t floor_units = room ? 1 : 0;
         while (assigned < kGrid)
-            for (size_t k = 0; k < order.size() && assigned < kGrid; ++k) ++units[order[k]], ++assigned;
+            for (size_t k = 0; k < order.size() && assigned < kGrid; ++k)
+                ++units[order[k]], ++assigned;
         while (assigned > kGrid) {
             bool took = false;
             for (size_t k = order.size(); k-- > 0 && assigned > kGrid;) {
@@ -127,8 +128,8 @@ std::vector<gpu::AliasEntry> build_alias_table(const std::vector<double>& weight
     std::vector<uint64_t> count(n, 0);
     std::vector<gpu::AliasEntry> table(n);
     for (size_t b = 0; b < n; ++b) {
-        const uint64_t first = (uint64_t(b) * kGrid + n - 1) / n;     // ceil(b·2^24 / n)
-        const uint64_t end = (uint64_t(b + 1) * kGrid + n - 1) / n;   // ceil((b+1)·2^24 / n)
+        const uint64_t first = (uint64_t(b) * kGrid + n - 1) / n;    // ceil(b·2^24 / n)
+        const uint64_t end = (uint64_t(b + 1) * kGrid + n - 1) / n;  // ceil((b+1)·2^24 / n)
         const uint64_t c = end - first, start = first * n - uint64_t(b) * kGrid;
         uint64_t d = weights[b] > 0.0 ? uint64_t(std::llround(prob[b] * double(c))) : 0;
         if (weights[b] > 0.0 && d == 0 && c > 0) d = 1;

@@ -47,17 +47,18 @@ std::string error_caused_by(const std::string& log, const std::string& file,
     std::string line, first;
     while (std::getline(in, line)) {
         // A note naming the file and line (clang's "note: previous definition is here").
-        if (size_t at = line.find(file + ":"); at != std::string::npos &&
-                                               line.find("note") != std::string::npos && !first.empty()) {
+        if (size_t at = line.find(file + ":");
+            at != std::string::npos && line.find("note") != std::string::npos && !first.empty()) {
             size_t digits = at + file.size() + 1, end = digits;
             while (end < line.size() && std::isdigit(static_cast<unsigned char>(line[end]))) ++end;
             if (end > digits) {
                 // "mcrt's kernels already define 'render' (render.cl:13:13: conflicting ...)",
                 // as where no note names the line (below).
                 const size_t open = first.find('\''), close = first.find('\'', open + 1);
-                const std::string name = close == std::string::npos
-                                             ? std::string()
-                                             : " '" + first.substr(open + 1, close - open - 1) + "'";
+                const std::string name =
+                    close == std::string::npos
+                        ? std::string()
+                        : " '" + first.substr(open + 1, close - open - 1) + "'";
                 return file + ":" + line.substr(digits, end - digits) +
                        ": mcrt's kernels already define" + (name.empty() ? " a name of it" : name) +
                        " (" + first + ")";
@@ -108,7 +109,8 @@ std::string estimator_build_error(const std::string& log, const std::string& fil
         return file + ":" + std::to_string(line_number) +
                ": environment_radiance takes (scene, direction): the unit world direction the ray "
                "left the scene along, which an environment map (--env) needs "
-               "(docs/ESTIMATORS.md) (" + error.substr(error.find(": ", digits) + 2) + ")";
+               "(docs/ESTIMATORS.md) (" +
+               error.substr(error.find(": ", digits) + 2) + ")";
     return error;
 }
 

@@ -12,16 +12,18 @@
 
 namespace mcrt {
 
-
 static gpu::float4 to_float4(const glm::vec3& v, float w = 0.0f) { return {v.x, v.y, v.z, w}; }
 
 namespace {
 
 uint32_t wrap_bits(TextureWrap wrap) {
     switch (wrap) {
-        case TextureWrap::Repeat: return TEXTURE_WRAP_REPEAT;
-        case TextureWrap::ClampToEdge: return TEXTURE_WRAP_CLAMP;
-        case TextureWrap::MirroredRepeat: return TEXTURE_WRAP_MIRROR;
+        case TextureWrap::Repeat:
+            return TEXTURE_WRAP_REPEAT;
+        case TextureWrap::ClampToEdge:
+            return TEXTURE_WRAP_CLAMP;
+        case TextureWrap::MirroredRepeat:
+            return TEXTURE_WRAP_MIRROR;
     }
     return TEXTURE_WRAP_REPEAT;
 }
@@ -41,9 +43,12 @@ gpu::TextureSlot texture_slot(const TextureRef& ref) {
 
 uint32_t alpha_mode_bits(AlphaMode mode) {
     switch (mode) {
-        case AlphaMode::Opaque: return MATERIAL_ALPHA_OPAQUE;
-        case AlphaMode::Mask: return MATERIAL_ALPHA_MASK;
-        case AlphaMode::Blend: return MATERIAL_ALPHA_BLEND;
+        case AlphaMode::Opaque:
+            return MATERIAL_ALPHA_OPAQUE;
+        case AlphaMode::Mask:
+            return MATERIAL_ALPHA_MASK;
+        case AlphaMode::Blend:
+            return MATERIAL_ALPHA_BLEND;
     }
     return MATERIAL_ALPHA_OPAQUE;
 }
@@ -142,9 +147,9 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
         const float alpha = std::max(m.roughness * m.roughness, MCRT_ALPHA_MIN);
         g.base_color = to_float4(m.albedo, 1.0f);
         g.emission = to_float4(m.emission);
-        g.specular = to_float4(glm::min(dielectric_f0(m.ior) * m.specular_color, glm::vec3(1.0f)) *
-                                   m.specular,
-                               m.specular);
+        g.specular = to_float4(
+            glm::min(dielectric_f0(m.ior) * m.specular_color, glm::vec3(1.0f)) * m.specular,
+            m.specular);
         g.metallic = m.metallic;
         g.alpha = alpha;
         g.type = m.lambertian() ? MATERIAL_LAMBERTIAN : MATERIAL_METALLIC_ROUGHNESS;
@@ -204,8 +209,7 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
     // Punctual lights after the area lights, by their power (punctual_power: the disk of the
     // scene's bounding sphere for a directional light), in the tree with pbrt-v4's bounds.
     const glm::dvec3 scene_lo(scene.bounds_min()), scene_hi(scene.bounds_max());
-    const double radius =
-        scene.triangle_count() > 0 ? 0.5 * glm::length(scene_hi - scene_lo) : 0.0;
+    const double radius = scene.triangle_count() > 0 ? 0.5 * glm::length(scene_hi - scene_lo) : 0.0;
     constexpr double kPi = 3.14159265358979323846;
     for (const PunctualLight& l : scene.punctual_lights) {
         gpu::PunctualGpu g{};
@@ -215,13 +219,14 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
         g.spot_scale = l.spot_scale;
         g.spot_offset = l.spot_offset;
         LightTreeItem item;
-        const double y =
-            0.2126 * l.intensity.r + 0.7152 * l.intensity.g + 0.0722 * l.intensity.b;
+        const double y = 0.2126 * l.intensity.r + 0.7152 * l.intensity.g + 0.0722 * l.intensity.b;
         item.lo = item.hi = glm::dvec3(l.position);
         item.axis = glm::dvec3(l.direction);
         item.phi = 4.0 * kPi * y;
         switch (l.type) {
-            case PunctualType::Point: g.type = PUNCTUAL_POINT; break;
+            case PunctualType::Point:
+                g.type = PUNCTUAL_POINT;
+                break;
             case PunctualType::Spot:
                 g.type = PUNCTUAL_SPOT;
                 // θ_o = inner, θ_e = outer − inner: the falloff is positive for θ < outer, where
@@ -297,9 +302,14 @@ void build_light_selection(GpuSceneData& data, LightSelection selection) {
     data.light_tree = LightTree{};
     const std::vector<double>& powers = data.light_powers;
     switch (selection) {
-        case LightSelection::Uniform: break;
-        case LightSelection::Power: data.light_cdf = build_cdf(powers); break;
-        case LightSelection::Alias: data.light_alias = build_alias_table(powers); break;
+        case LightSelection::Uniform:
+            break;
+        case LightSelection::Power:
+            data.light_cdf = build_cdf(powers);
+            break;
+        case LightSelection::Alias:
+            data.light_alias = build_alias_table(powers);
+            break;
         case LightSelection::Tree:
             data.light_tree = build_light_tree(data.lights, powers, 0, data.punctual_tree_items);
             break;
@@ -314,9 +324,12 @@ std::vector<uint32_t> light_selection_words(const GpuSceneData& data, uint32_t* 
         return w;
     };
     switch (data.light_selection) {
-        case LightSelection::Uniform: return {};
-        case LightSelection::Power: return words(data.light_cdf);
-        case LightSelection::Alias: return words(data.light_alias);
+        case LightSelection::Uniform:
+            return {};
+        case LightSelection::Power:
+            return words(data.light_cdf);
+        case LightSelection::Alias:
+            return words(data.light_alias);
         case LightSelection::Tree:
             *tree_nodes = uint32_t(std::max<size_t>(data.light_tree.nodes.size(), 1));
             return light_tree_words(data.light_tree);

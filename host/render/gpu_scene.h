@@ -2,10 +2,9 @@
 // their buffers on one device.
 #pragma once
 
+#include <CL/opencl.hpp>
 #include <string>
 #include <vector>
-
-#include <CL/opencl.hpp>
 
 #include "bvh/bvh.h"
 #include "cl/device.h"
@@ -17,8 +16,8 @@
 namespace mcrt {
 
 struct GpuSceneData {
-    std::vector<gpu::Bvh4Node> nodes;  // 4-wide, as the kernels traverse it
-    std::vector<gpu::TrianglePacket> packets;  // the leaves' triangles, four per ray test
+    std::vector<gpu::Bvh4Node> nodes;              // 4-wide, as the kernels traverse it
+    std::vector<gpu::TrianglePacket> packets;      // the leaves' triangles, four per ray test
     std::vector<gpu::TriangleInfo> triangle_info;  // per packet lane: 4 per packet
     std::vector<gpu::Material> materials;
     std::vector<gpu::Light> lights;

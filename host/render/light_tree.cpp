@@ -1,17 +1,17 @@
 #include "render/light_tree.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <glm/glm.hpp>
-#include <atomic>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <new>
-#include <type_traits>
 #include <system_error>
 #include <thread>
+#include <type_traits>
 
 namespace mcrt {
 namespace {
@@ -215,7 +215,7 @@ void parallel_for(int threads, size_t n, Fn fn) {
 // The threads a build may still start beyond its own: taken before a thread starts, given back
 // when its work is done, so that work still running elsewhere can take it.
 class ThreadBudget {
-public:
+  public:
     explicit ThreadBudget(int spare) : spare_(spare) {}
     bool take() {
         int n = spare_.load();
@@ -225,7 +225,7 @@ public:
     }
     void give_back() { spare_ += 1; }
 
-private:
+  private:
     std::atomic<int> spare_;
 };
 
@@ -242,7 +242,7 @@ constexpr size_t kSweepMax = 16;
 // A node of the binary tree the wide one is collapsed from.
 struct BinaryNode {
     Bounds bounds;
-    uint32_t left = 0;   // inner: index of the first child (the second follows its subtree)
+    uint32_t left = 0;  // inner: index of the first child (the second follows its subtree)
     uint32_t right = 0;
     uint32_t light = 0;  // leaf: its light
     bool leaf = false;
@@ -292,7 +292,8 @@ struct BinaryBuilder {
             std::vector<Side> parts(chunks);
             auto take = [&](size_t from, size_t to) {
                 for (size_t c = from; c < to; ++c)
-                    for (size_t i = begin + c * kChunk; i < std::min(end, begin + (c + 1) * kChunk); ++i)
+                    for (size_t i = begin + c * kChunk; i < std::min(end, begin + (c + 1) * kChunk);
+                         ++i)
                         parts[c].add(items[order[i]], centroid[order[i]]);
             };
             if (chunks > 1 && budget.take()) {
@@ -384,16 +385,18 @@ struct BinaryBuilder {
             }
         }
         // Every centroid at one point: cut the middle of the order.
-        if (best_cut == 0) best_cut = n / 2;
-        else std::copy(best_order, best_order + n, order.begin() + long(begin));
+        if (best_cut == 0)
+            best_cut = n / 2;
+        else
+            std::copy(best_order, best_order + n, order.begin() + long(begin));
         sides(begin, begin + best_cut, end, halves);
         return begin + best_cut;
     }
 
-
     // Where order[begin, end) is cut, with what is known of both sides in halves: the binned
-    // SAOH's best bucket boundary, the sweep's best cut for few lights, or the median of the widest centroid axis when no bucket
-    // split exists or the path would grow too long. The three axes are binned in one pass.
+    // SAOH's best bucket boundary, the sweep's best cut for few lights, or the median of the widest
+    // centroid axis when no bucket split exists or the path would grow too long. The three axes are
+    // binned in one pass.
     size_t split(size_t begin, size_t end, const Bounds& all, const Bounds& centroids, int depth,
                  Side* halves) {
         const size_t n = end - begin;
@@ -408,7 +411,8 @@ struct BinaryBuilder {
         double best_cost = std::numeric_limits<double>::infinity();
         int best_dim = -1, best_bucket = -1;
         glm::dvec3 scale;
-        for (int dim = 0; dim < 3; ++dim) scale[dim] = extent[dim] > 0.0 ? kBuckets / extent[dim] : 0.0;
+        for (int dim = 0; dim < 3; ++dim)
+            scale[dim] = extent[dim] > 0.0 ? kBuckets / extent[dim] : 0.0;
         auto bucket_of = [&](uint32_t item, int dim) {
             double t = (centroid[item][dim] - centroids.lo[dim]) * scale[dim];
             return std::clamp(int(t), 0, kBuckets - 1);
@@ -416,8 +420,8 @@ struct BinaryBuilder {
         if (!balance && n <= kSweepMax) return sweep(begin, end, diagonal, extent, halves);
         if (!balance) {
             Bins all_bins;
-            Bounds (&bucket)[3][kBuckets] = all_bins.bucket;
-            size_t (&count)[3][kBuckets] = all_bins.count;
+            Bounds(&bucket)[3][kBuckets] = all_bins.bucket;
+            size_t(&count)[3][kBuckets] = all_bins.count;
             auto bin = [&](size_t from, size_t to, Bins& bins) {
                 for (size_t i = from; i < to; ++i) {
                     const uint32_t item = order[i];
@@ -442,7 +446,8 @@ struct BinaryBuilder {
                         bin(begin + c * kChunk, std::min(end, begin + (c + 1) * kChunk), parts[c]);
                 };
                 if (budget.take()) {
-                    beside([&] { bin_chunks(0, chunks / 2); }, [&] { bin_chunks(chunks / 2, chunks); });
+                    beside([&] { bin_chunks(0, chunks / 2); },
+                           [&] { bin_chunks(chunks / 2, chunks); });
                     budget.give_back();
                 } else {
                     bin_chunks(0, chunks);
@@ -494,7 +499,8 @@ struct BinaryBuilder {
                     for (size_t i = from; i < to; ++i) out.add(items[order[i]], centroid[order[i]]);
                 };
                 if (budget.take()) {
-                    beside([&] { side(begin, mid, halves[0]); }, [&] { side(mid, end, halves[1]); });
+                    beside([&] { side(begin, mid, halves[0]); },
+                           [&] { side(mid, end, halves[1]); });
                     budget.give_back();
                 } else {
                     side(begin, mid, halves[0]);
@@ -556,8 +562,8 @@ void set_slot(gpu::LightTreeNode& node, int k, const Bounds& b, uint32_t child, 
     (&node.ay.x)[k] = float(b.normals.w.y);
     (&node.az.x)[k] = float(b.normals.w.z);
     (&node.cos_o.x)[k] = cos_o_f;
-    (&node.sin_o.x)[k] = std::min(
-        1.0f, round_up(std::sqrt(std::max(0.0, 1.0 - double(cos_o_f) * double(cos_o_f)))));
+    (&node.sin_o.x)[k] =
+        std::min(1.0f, round_up(std::sqrt(std::max(0.0, 1.0 - double(cos_o_f) * double(cos_o_f)))));
     (&node.cos_e.x)[k] = round_down(b.cos_e);
     (&node.phi.x)[k] = float(b.phi);
     node.child[k] = child;
@@ -637,14 +643,12 @@ struct Collapser {
         }
         for (std::thread& t : threads) t.join();
     }
-
 };
 
 }  // namespace
 
-LightTree build_light_tree(const std::vector<gpu::Light>& lights,
-                           const std::vector<double>& powers, int threads,
-                           const std::vector<LightTreeItem>& more) {
+LightTree build_light_tree(const std::vector<gpu::Light>& lights, const std::vector<double>& powers,
+                           int threads, const std::vector<LightTreeItem>& more) {
     LightTree tree;
     const size_t total = lights.size() + more.size();
     tree.paths.assign(total, gpu::LightTreePath{0u, 0u});
@@ -674,8 +678,8 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
             if (!(powers[i] > 0.0)) continue;
             glm::dvec3 p[3];
             vertices(i, p);
-            centre[i] = 0.5 * (glm::min(p[0], glm::min(p[1], p[2])) +
-                               glm::max(p[0], glm::max(p[1], p[2])));
+            centre[i] =
+                0.5 * (glm::min(p[0], glm::min(p[1], p[2])) + glm::max(p[0], glm::max(p[1], p[2])));
             part.lo = glm::min(part.lo, centre[i]);
             part.hi = glm::max(part.hi, centre[i]);
         }
@@ -698,8 +702,8 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
     parallel_for(threads, keys.size(), [&](size_t begin, size_t end) {
         for (size_t k = begin; k < end; ++k) {
             const glm::dvec3 t = (centre[keys[k]] - box.lo) / extent * 1023.0;
-            const uint32_t code = spread(uint32_t(t.x)) | (spread(uint32_t(t.y)) << 1) |
-                                  (spread(uint32_t(t.z)) << 2);
+            const uint32_t code =
+                spread(uint32_t(t.x)) | (spread(uint32_t(t.y)) << 1) | (spread(uint32_t(t.z)) << 2);
             keys[k] |= uint64_t(code) << 32;
         }
     });
@@ -779,12 +783,13 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights,
 
 std::vector<uint32_t> light_tree_words(const LightTree& tree) {
     const size_t nodes = std::max<size_t>(tree.nodes.size(), 1);  // an empty tree: one zero node
-    std::vector<uint32_t> words((nodes * sizeof(gpu::LightTreeNode) +
-                                 tree.paths.size() * sizeof(gpu::LightTreePath)) /
-                                    sizeof(uint32_t),
-                                0u);
+    std::vector<uint32_t> words(
+        (nodes * sizeof(gpu::LightTreeNode) + tree.paths.size() * sizeof(gpu::LightTreePath)) /
+            sizeof(uint32_t),
+        0u);
     if (!tree.nodes.empty())
-        std::memcpy(words.data(), tree.nodes.data(), tree.nodes.size() * sizeof(gpu::LightTreeNode));
+        std::memcpy(words.data(), tree.nodes.data(),
+                    tree.nodes.size() * sizeof(gpu::LightTreeNode));
     if (!tree.paths.empty())
         std::memcpy(words.data() + nodes * sizeof(gpu::LightTreeNode) / sizeof(uint32_t),
                     tree.paths.data(), tree.paths.size() * sizeof(gpu::LightTreePath));

@@ -40,9 +40,8 @@ struct LightTreeItem {
 // node. No path is longer than MCRT_LIGHT_TREE_MAX_DEPTH nodes.
 // `more` are lights lights.size() + k after the triangles (their inclusion, as every light's,
 // decided by `powers`, which has an entry for each); a tree without them is the same as before.
-LightTree build_light_tree(const std::vector<gpu::Light>& lights,
-                           const std::vector<double>& powers, int threads = 0,
-                           const std::vector<LightTreeItem>& more = {});
+LightTree build_light_tree(const std::vector<gpu::Light>& lights, const std::vector<double>& powers,
+                           int threads = 0, const std::vector<LightTreeItem>& more = {});
 
 // The tree as the kernels read it from the selection's buffer: its nodes (at least one), then
 // one path per light (RENDER_ARG_LIGHT_SELECTION), as 32-bit words.

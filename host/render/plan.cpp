@@ -1,10 +1,9 @@
 #include "render/plan.h"
 
-#include "common/activity.h"
-
 #include <chrono>
 #include <cmath>
 
+#include "common/activity.h"
 #include "common/error.h"
 
 namespace mcrt {
@@ -54,7 +53,9 @@ RenderPlan check_render_settings(RenderSettings settings, const std::optional<gl
     // The ambient estimators' sky is 1 unless given; for the others a sky makes it a light.
     // An environment map takes the sky's place (plan_environment).
     if (!settings.env.empty()) {
-        if (sky) throw SettingError("env", settings.env + ": --env and --sky both give the sky; give one");
+        if (sky)
+            throw SettingError("env",
+                               settings.env + ": --env and --sky both give the sky; give one");
         if (!std::isfinite(settings.env_scale) || settings.env_scale < 0.0f)
             throw SettingError("env_scale", std::to_string(settings.env_scale) +
                                                 ": expected a finite number >= 0");
@@ -91,20 +92,19 @@ void plan_environment(RenderPlan& plan, const GpuSceneData& scene, const SceneSo
 
 RenderPlan finish_render_plan(RenderPlan plan, const GpuSceneData& scene) {
     const RenderSettings& s = plan.settings;
-    plan.program_options = variant_program_options(plan.variants, scene.microfacet, scene.textured,
-                                                   scene.transmission, scene.single_sided,
-                                                   plan.environment != nullptr,
-                                                   !scene.punctual.empty());
-    plan.fixed_batch =
-        s.batch > 0 ? uint64_t(s.width) * uint64_t(s.height) *
-                          batch_samples_per_pixel(s.batch, s.width, s.height, s.spp)
-                    : 0;
+    plan.program_options = variant_program_options(
+        plan.variants, scene.microfacet, scene.textured, scene.transmission, scene.single_sided,
+        plan.environment != nullptr, !scene.punctual.empty());
+    plan.fixed_batch = s.batch > 0 ? uint64_t(s.width) * uint64_t(s.height) *
+                                         batch_samples_per_pixel(s.batch, s.width, s.height, s.spp)
+                                   : 0;
     return plan;
 }
 
 RenderPlan make_render_plan(const RenderSettings& settings, const GpuSceneData& scene) {
     const bool env = !settings.env.empty();
-    RenderPlan plan = check_render_settings(settings, env ? std::nullopt : std::optional(settings.sky));
+    RenderPlan plan =
+        check_render_settings(settings, env ? std::nullopt : std::optional(settings.sky));
     if (!env) {  // the sky as the caller of a device scene chose it
         plan.settings.sky = settings.sky;
         plan.settings.sky_light = settings.sky_light;
@@ -126,8 +126,7 @@ void warn_unseen_lights(const std::string& scene_path, const RenderPlan& plan,
              (v.uses(kUsesSkyLight) ? " (--sky R,G,B adds a sky light)" : ""));
     if (punctual > 0 && !sees_punctual)
         warn(scene_path + ": estimator " + v.estimator.name + " cannot see the scene's " +
-             std::to_string(punctual) + " KHR_lights_punctual light" +
-             (punctual == 1 ? "" : "s") +
+             std::to_string(punctual) + " KHR_lights_punctual light" + (punctual == 1 ? "" : "s") +
              " (delta lights: no direction it draws finds one); light-area, light-solid-angle "
              "and mis sample them");
 }
@@ -139,13 +138,14 @@ Camera choose_camera(const Scene& scene, const CameraChoice& choice) {
         const size_t count = scene.gltf_camera_types.size();
         const std::string k = std::to_string(choice.index);
         if (size_t(choice.index) >= count)
-            throw SettingError("camera", k + ": " + scene.path + " has " + std::to_string(count) +
-                                             (count == 1 ? " camera" : " cameras") +
-                                             (count ? " (0 to " + std::to_string(count - 1) + ")" : ""));
+            throw SettingError("camera",
+                               k + ": " + scene.path + " has " + std::to_string(count) +
+                                   (count == 1 ? " camera" : " cameras") +
+                                   (count ? " (0 to " + std::to_string(count - 1) + ")" : ""));
         const std::string& type = scene.gltf_camera_types[size_t(choice.index)];
         if (type != "perspective")
-            throw SettingError("camera", k + ": camera " + k + " of " + scene.path + " is " +
-                                             type + "; only perspective cameras are rendered");
+            throw SettingError("camera", k + ": camera " + k + " of " + scene.path + " is " + type +
+                                             "; only perspective cameras are rendered");
         for (const Camera& camera : scene.cameras)
             if (camera.gltf_index == choice.index) return camera;
         throw SettingError("camera", k + ": camera " + k + " of " + scene.path +

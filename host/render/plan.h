@@ -7,11 +7,10 @@
 
 #include <cstdint>
 #include <functional>
+#include <glm/glm.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "bvh/bvh.h"
 #include "render/environment_light.h"
@@ -42,9 +41,9 @@ struct RenderRequest {
 // Where the scene's files come from: disk (recording what was read, for the other ranks of a
 // job), or a bundle another rank read.
 struct SceneSource {
-    const FileBundle* bundle = nullptr;        // read every file from here, not from disk
+    const FileBundle* bundle = nullptr;              // read every file from here, not from disk
     std::vector<std::string>* files_read = nullptr;  // disk: the files read, appended
-    FileBundle* record = nullptr;              // disk: their bytes, for the other ranks
+    FileBundle* record = nullptr;                    // disk: their bytes, for the other ranks
 };
 
 // The part of a render that the devices need: the settings, their variants as rows, the

@@ -1,19 +1,18 @@
 #include "render/renderer.h"
 
-#include "common/activity.h"
-
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
-#include <deque>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <deque>
 #include <mutex>
 #include <optional>
 #include <thread>
 
+#include "common/activity.h"
 #include "common/error.h"
 #include "render/accumulator.h"
 #include "render/agreement.h"
@@ -80,7 +79,9 @@ RenderResult render_with_workers(const std::vector<const DeviceContext*>& device
         } catch (const RuntimeError& e) {
             if (devices.size() == 1 && !remote) throw;
             last_error = e.what();
-            if (warn) warn("skipping device " + std::to_string(d->info.index) + " ('" + d->info.name + "'): " + e.what());
+            if (warn)
+                warn("skipping device " + std::to_string(d->info.index) + " ('" + d->info.name +
+                     "'): " + e.what());
         }
     }
     if (control.launching && !remote) control.launching();
@@ -92,7 +93,8 @@ RenderResult render_with_workers(const std::vector<const DeviceContext*>& device
     if (workers.empty()) throw RuntimeError("no device can render this scene: " + last_error);
     bool any_working = false;
     for (const auto& w : workers) any_working |= !w->report.retired;
-    if (!any_working) throw RuntimeError("every device failed; no image was completed: " + last_error);
+    if (!any_working)
+        throw RuntimeError("every device failed; no image was completed: " + last_error);
 
     RenderResult result;
     result.seconds_build = seconds_since(start);
@@ -152,17 +154,21 @@ RenderResult render_with_workers(const std::vector<const DeviceContext*>& device
             } catch (const RuntimeError& e) {
                 std::lock_guard<std::mutex> lock(acc_mutex);
                 worker.report.retired = true;
-                const std::string rank =
-                    worker.report.rank > 0 ? "rank " + std::to_string(worker.report.rank) + " " : "";
-                if (warn) warn(rank + "device " + std::to_string(worker.report.index) + " ('" + worker.report.name + "') failed and is retired; its work is redone on the other devices: " + e.what());
+                const std::string rank = worker.report.rank > 0
+                                             ? "rank " + std::to_string(worker.report.rank) + " "
+                                             : "";
+                if (warn)
+                    warn(rank + "device " + std::to_string(worker.report.index) + " ('" +
+                         worker.report.name +
+                         "') failed and is retired; its work is redone on the other devices: " +
+                         e.what());
                 if (item) queue.give_back(*item);
                 for (const WorkItem& w : started) queue.give_back(w);
                 progress_made.notify_all();
                 return;
             }
             std::lock_guard<std::mutex> lock(acc_mutex);
-            if (result.seconds_first_batch == 0)
-                result.seconds_first_batch = seconds_since(start);
+            if (result.seconds_first_batch == 0) result.seconds_first_batch = seconds_since(start);
             worker.commit_report();
             acc.submit(std::move(r));
             queue.done(started.front());
@@ -234,11 +240,12 @@ RenderResult render_with_workers(const std::vector<const DeviceContext*>& device
     result.seconds_render_wall = seconds_since(start) - result.seconds_build;
 
     if (acc.committed_spp() == 0 && !result.stopped_by.empty())
-        throw RuntimeError("stopped by " + result.stopped_by +
-                           " before every pixel had its first " +
-                           std::to_string(std::min<uint32_t>(MCRT_SAMPLES_PER_CHUNK, settings.spp)) +
-                           " samples; no image was written");
-    if (acc.committed_spp() == 0 || (result.stopped_by.empty() && acc.committed_spp() < settings.spp))
+        throw RuntimeError(
+            "stopped by " + result.stopped_by + " before every pixel had its first " +
+            std::to_string(std::min<uint32_t>(MCRT_SAMPLES_PER_CHUNK, settings.spp)) +
+            " samples; no image was written");
+    if (acc.committed_spp() == 0 ||
+        (result.stopped_by.empty() && acc.committed_spp() < settings.spp))
         throw RuntimeError("every device failed; no image was completed");
     if (progress) progress(acc.committed_spp(), settings.spp, device_reports());
     result.spp = acc.committed_spp();

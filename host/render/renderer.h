@@ -4,15 +4,14 @@
 #include <csignal>
 #include <cstdint>
 #include <functional>
+#include <glm/glm.hpp>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include <glm/glm.hpp>
-
 #include "cl/device.h"
-#include "image/image.h"
 #include "common/stop_signals.h"
+#include "image/image.h"
 #include "render/gpu_scene.h"
 
 namespace mcrt {
@@ -22,23 +21,23 @@ namespace mcrt {
 struct RenderSettings {
     int width = 512, height = 512;
     uint32_t spp = 16;
-    std::string estimator = "light-area";  // a row of kEstimatorVariants; unused with a file
-    std::string estimator_file;    // a user's estimator (--estimator-file), "" for none
-    std::string estimator_source;  // its text (read_estimator_file)
-    std::string light_select = "power";    // kLightSelectVariants
-    std::string sampler = "independent";   // kSamplerVariants
-    std::string mis_heuristic = "balance"; // kMisHeuristicVariants
-    std::string materials = "gltf";        // kMaterialVariants (the scene is read accordingly)
-    glm::vec3 sky{1.0f};        // ambient estimators: uniform sky radiance; else the sky light's
-    bool sky_light = false;     // direct and path estimators: the sky is a light (--sky given)
-    float ao_distance = 0.0f;   // ambient estimators: occlusion range, 0 = unbounded
+    std::string estimator = "light-area";   // a row of kEstimatorVariants; unused with a file
+    std::string estimator_file;             // a user's estimator (--estimator-file), "" for none
+    std::string estimator_source;           // its text (read_estimator_file)
+    std::string light_select = "power";     // kLightSelectVariants
+    std::string sampler = "independent";    // kSamplerVariants
+    std::string mis_heuristic = "balance";  // kMisHeuristicVariants
+    std::string materials = "gltf";         // kMaterialVariants (the scene is read accordingly)
+    glm::vec3 sky{1.0f};       // ambient estimators: uniform sky radiance; else the sky light's
+    bool sky_light = false;    // direct and path estimators: the sky is a light (--sky given)
+    float ao_distance = 0.0f;  // ambient estimators: occlusion range, 0 = unbounded
     // An environment map (--env: .exr or .hdr, "" for none) in place of the uniform sky: the
     // ambient estimators' sky, and for the others a light beside the area lights.
     std::string env;
     float env_scale = 1.0f;   // multiplies its texels
     float env_rotate = 0.0f;  // degrees about +Y, counter-clockwise seen from above
-    uint32_t max_depth = 1;     // reflections per path, 0 .. MCRT_MAX_PATH_DEPTH; 1: direct light
-    uint32_t rr_depth = 5;      // Russian roulette before reflection k + 1 for every k >= rr_depth
+    uint32_t max_depth = 1;   // reflections per path, 0 .. MCRT_MAX_PATH_DEPTH; 1: direct light
+    uint32_t rr_depth = 5;    // Russian roulette before reflection k + 1 for every k >= rr_depth
     uint32_t seed = 0;
     uint32_t batch = 0;  // samples per pixel per launch; 0 chooses; rounded up to whole chunks
     // Independent randomizations of the sampler the variance layer is estimated from (1: the
@@ -48,7 +47,7 @@ struct RenderSettings {
 
 struct DeviceReport {
     std::string name;
-    int index = 0;            // as `mcrt devices` lists it
+    int index = 0;  // as `mcrt devices` lists it
     uint64_t samples = 0;
     uint64_t batches = 0;
     double seconds_busy = 0;  // kernel time from profiling events
@@ -63,16 +62,16 @@ using RemoteWorkers = std::function<std::vector<std::unique_ptr<RenderWorker>>()
 
 struct RenderResult {
     Image image;
-    uint32_t replicates = 1;     // what the variance layer was estimated from (1: the samples)
-    uint64_t variance_clamped = 0;  // variance values beyond float's range, written as FLT_MAX
-    uint32_t spp = 0;            // samples per pixel in the image (fewer if stopped early)
-    std::string stopped_by;      // "", "time limit" or "interrupt"
-    uint64_t nan_samples = 0;    // non-finite samples, left out of the image
-    uint64_t rays = 0;           // camera and shadow rays traced
-    uint64_t path_vertices = 0;  // surface points the paths reached (the camera's hit included)
-    uint64_t roulette_ends = 0;  // paths that Russian roulette ended
-    double seconds_render = 0;   // kernel time summed over devices (profiling events)
-    double seconds_build = 0;    // kernel compilation and scene upload
+    uint32_t replicates = 1;         // what the variance layer was estimated from (1: the samples)
+    uint64_t variance_clamped = 0;   // variance values beyond float's range, written as FLT_MAX
+    uint32_t spp = 0;                // samples per pixel in the image (fewer if stopped early)
+    std::string stopped_by;          // "", "time limit" or "interrupt"
+    uint64_t nan_samples = 0;        // non-finite samples, left out of the image
+    uint64_t rays = 0;               // camera and shadow rays traced
+    uint64_t path_vertices = 0;      // surface points the paths reached (the camera's hit included)
+    uint64_t roulette_ends = 0;      // paths that Russian roulette ended
+    double seconds_render = 0;       // kernel time summed over devices (profiling events)
+    double seconds_build = 0;        // kernel compilation and scene upload
     double seconds_render_wall = 0;  // wall clock from the first launch to the last result
     double seconds_first_batch = 0;  // wall clock from render() to the first batch accumulated
     // With RenderControl::keep_replicate_means and more than one replicate: each replicate's

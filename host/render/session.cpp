@@ -41,8 +41,8 @@ std::shared_ptr<SessionScene> load_session_scene(const std::string& path,
         // The camera's part of the layout is written at each render (write_camera): here only
         // its size matters, not its image's.
         const Activity activity("laying out the scene for the devices");
-        prepared.gpu = make_gpu_scene(prepared.scene, prepared.bvh, prepared.camera, 1, 1,
-                                      selection);
+        prepared.gpu =
+            make_gpu_scene(prepared.scene, prepared.bvh, prepared.camera, 1, 1, selection);
     }
     return loaded;
 }
@@ -83,8 +83,8 @@ RenderSession::RenderSession(const std::vector<DeviceInfo>& devices, const Warni
         } catch (const RuntimeError& e) {
             if (devices.size() == 1 || (contexts_.empty() && &d == &devices.back())) throw;
             if (warn)
-                warn("skipping device " + std::to_string(d.index) + " ('" + d.name + "'): " +
-                     e.what());
+                warn("skipping device " + std::to_string(d.index) + " ('" + d.name +
+                     "'): " + e.what());
         }
     }
 }

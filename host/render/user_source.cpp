@@ -22,20 +22,20 @@ enum class Kind { Ident, Number, String, HeaderName, Punct, Other };
 
 struct Token {
     Kind kind;
-    std::string text;  // digraphs spelled as their punctuators (C99 6.4.6p3)
-    size_t begin, end; // in the spliced text
-    bool bol;          // a new-line (also one inside a comment) since the previous token
-    bool nl;           // a new-line outside comments since the previous token: ends a directive
-    bool space;        // white space or a comment right before it
+    std::string text;   // digraphs spelled as their punctuators (C99 6.4.6p3)
+    size_t begin, end;  // in the spliced text
+    bool bol;           // a new-line (also one inside a comment) since the previous token
+    bool nl;            // a new-line outside comments since the previous token: ends a directive
+    bool space;         // white space or a comment right before it
 };
 
 class Checker {
-public:
+  public:
     Checker(const std::string& name, const std::string& text) : name_(name), text_(text) {}
 
     UserSource run(const std::string& required_function);
 
-private:
+  private:
     [[noreturn]] void fail(size_t original_offset, const std::string& message) const {
         throw InputError(name_ + ":" + std::to_string(line_of(original_offset)) + ": " + message);
     }
@@ -44,7 +44,8 @@ private:
     }
     int line_of(size_t offset) const {
         return static_cast<int>(std::upper_bound(line_starts_.begin(), line_starts_.end(), offset) -
-                                line_starts_.begin()) + 1;
+                                line_starts_.begin()) +
+               1;
     }
     void phases_1_2();
     void lex();
@@ -62,7 +63,7 @@ private:
     std::string s_;                    // after line splicing, new-lines as '\n'
     std::vector<size_t> orig_;         // original offset of each character of s_
     std::vector<Token> tokens_;
-    std::vector<Token> code_;              // tokens outside directives, in regions that may be active
+    std::vector<Token> code_;  // tokens outside directives, in regions that may be active
     std::vector<std::pair<size_t, size_t>> blank_;  // original ranges of `#include "api.cl"`
 
     struct Macro {
@@ -128,10 +129,10 @@ void Checker::phases_1_2() {
 // Phase 3: comments become white space; identifiers, pp-numbers, character and string literals
 // (with their L, u, U, u8 prefixes), header names after `# include`, punctuators (C99 6.4).
 void Checker::lex() {
-    static const char* const kPunctuators[] = {
-        "%:%:", "...", "<<=", ">>=", "->", "++", "--", "<<", ">>", "<=", ">=", "==", "!=", "&&",
-        "||",   "*=",  "/=",  "%=",  "+=", "-=", "&=", "^=", "|=", "##", "<:", ":>", "<%", "%>",
-        "%:"};
+    static const char* const kPunctuators[] = {"%:%:", "...", "<<=", ">>=", "->", "++", "--", "<<",
+                                               ">>",   "<=",  ">=",  "==",  "!=", "&&", "||", "*=",
+                                               "/=",   "%=",  "+=",  "-=",  "&=", "^=", "|=", "##",
+                                               "<:",   ":>",  "<%",  "%>",  "%:"};
     static const std::map<std::string, std::string> kDigraphs = {
         {"<:", "["}, {":>", "]"}, {"<%", "{"}, {"%>", "}"}, {"%:", "#"}, {"%:%:", "##"}};
     const std::string& s = s_;
@@ -167,12 +168,12 @@ void Checker::lex() {
         Token tok{Kind::Other, "", i, i, bol, nl, space};
         // A header name: `<...>` right after `# include` (C99 6.4.7).
         const size_t n = tokens_.size();
-        const bool after_include = n >= 2 && tokens_[n - 2].text == "#" && tokens_[n - 2].bol &&
-                                   tokens_[n - 1].kind == Kind::Ident &&
-                                   (tokens_[n - 1].text == "include" ||
-                                    tokens_[n - 1].text == "include_next" ||
-                                    tokens_[n - 1].text == "import") &&
-                                   !tok.nl;
+        const bool after_include =
+            n >= 2 && tokens_[n - 2].text == "#" && tokens_[n - 2].bol &&
+            tokens_[n - 1].kind == Kind::Ident &&
+            (tokens_[n - 1].text == "include" || tokens_[n - 1].text == "include_next" ||
+             tokens_[n - 1].text == "import") &&
+            !tok.nl;
         if (c == '<' && after_include) {
             size_t close = i + 1;
             while (close < s.size() && s[close] != '>' && s[close] != '\n') ++close;
@@ -195,8 +196,8 @@ void Checker::lex() {
             ++i;
             while (i < s.size()) {
                 char d = s[i];
-                if ((d == '+' || d == '-') && (s[i - 1] == 'e' || s[i - 1] == 'E' ||
-                                               s[i - 1] == 'p' || s[i - 1] == 'P'))
+                if ((d == '+' || d == '-') &&
+                    (s[i - 1] == 'e' || s[i - 1] == 'E' || s[i - 1] == 'p' || s[i - 1] == 'P'))
                     ++i;
                 else if (is_ident_char(static_cast<unsigned char>(d)) || d == '.')
                     ++i;
@@ -211,7 +212,8 @@ void Checker::lex() {
             const char quote_char = c;
             if (s[i] == quote_char) {
                 ++i;
-                while (i < s.size() && s[i] != quote_char && s[i] != '\n') i += s[i] == '\\' ? 2 : 1;
+                while (i < s.size() && s[i] != quote_char && s[i] != '\n')
+                    i += s[i] == '\\' ? 2 : 1;
                 if (i < s.size() && s[i] == quote_char) ++i;
                 i = std::min(i, s.size());
                 tok.kind = Kind::String;
@@ -229,7 +231,8 @@ void Checker::lex() {
                 std::string("=()'<>!-").find(s[i + 2]) != std::string::npos)
                 fail(orig_[i], "contains the trigraph " + s.substr(i, 3) +
                                    " (a punctuator to some compilers)");
-            const bool punct = std::string("[](){}.&*+-~!/%<>^|?:;=,#").find(c) != std::string::npos;
+            const bool punct =
+                std::string("[](){}.&*+-~!/%<>^|?:;=,#").find(c) != std::string::npos;
             tok.kind = punct ? Kind::Punct : Kind::Other;
             i += length;
         }
@@ -265,7 +268,7 @@ struct Value {
 };
 
 class Expression {
-public:
+  public:
     explicit Expression(std::vector<Value>&& values, std::vector<std::string>&& ops)
         : values_(values), ops_(ops) {}
     // Items: ops_[k] is "" where values_[k] is an operand, else the punctuator.
@@ -275,7 +278,7 @@ public:
         return v;
     }
 
-private:
+  private:
     bool at(const char* op) const { return pos_ < ops_.size() && ops_[pos_] == op; }
     void enter() {
         if (++depth_ > 200) throw Unknown{};
@@ -298,9 +301,9 @@ private:
     }
     static int precedence(const std::string& op) {
         static const std::map<std::string, int> p = {
-            {"||", 1}, {"&&", 2}, {"|", 3}, {"^", 4}, {"&", 5}, {"==", 6}, {"!=", 6},
-            {"<", 7},  {">", 7},  {"<=", 7}, {">=", 7}, {"<<", 8}, {">>", 8}, {"+", 9},
-            {"-", 9},  {"*", 10}, {"/", 10}, {"%", 10}};
+            {"||", 1}, {"&&", 2}, {"|", 3}, {"^", 4},  {"&", 5},  {"==", 6},
+            {"!=", 6}, {"<", 7},  {">", 7}, {"<=", 7}, {">=", 7}, {"<<", 8},
+            {">>", 8}, {"+", 9},  {"-", 9}, {"*", 10}, {"/", 10}, {"%", 10}};
         auto it = p.find(op);
         return it == p.end() ? -1 : it->second;
     }
@@ -362,9 +365,12 @@ private:
         if (at("+") || at("-") || at("~") || at("!")) {
             const std::string op = ops_[pos_++];
             v = unary();
-            if (op == "-") v.v = 0 - v.v;
-            else if (op == "~") v.v = ~v.v;
-            else if (op == "!") v = {v.known, false, v.v ? 0u : 1u};
+            if (op == "-")
+                v.v = 0 - v.v;
+            else if (op == "~")
+                v.v = ~v.v;
+            else if (op == "!")
+                v = {v.known, false, v.v ? 0u : 1u};
         } else if (at("(")) {
             ++pos_;
             v = conditional();
@@ -390,16 +396,22 @@ Value integer_constant(const std::string& t) {
     size_t i = 0;
     uint64_t v = 0;
     int base = 10;
-    if (t.size() > 1 && t[0] == '0' && (t[1] == 'x' || t[1] == 'X')) base = 16, i = 2;
-    else if (t[0] == '0') base = 8;
+    if (t.size() > 1 && t[0] == '0' && (t[1] == 'x' || t[1] == 'X'))
+        base = 16, i = 2;
+    else if (t[0] == '0')
+        base = 8;
     const size_t digits = i;
     for (; i < t.size(); ++i) {
         int d;
         char c = t[i];
-        if (c >= '0' && c <= '9') d = c - '0';
-        else if (base == 16 && c >= 'a' && c <= 'f') d = c - 'a' + 10;
-        else if (base == 16 && c >= 'A' && c <= 'F') d = c - 'A' + 10;
-        else break;
+        if (c >= '0' && c <= '9')
+            d = c - '0';
+        else if (base == 16 && c >= 'a' && c <= 'f')
+            d = c - 'a' + 10;
+        else if (base == 16 && c >= 'A' && c <= 'F')
+            d = c - 'A' + 10;
+        else
+            break;
         if (d >= base) throw Unknown{};
         if (v > (UINT64_MAX - d) / base) throw Unknown{};
         v = v * base + d;
@@ -408,8 +420,10 @@ Value integer_constant(const std::string& t) {
     bool is_unsigned = false;
     for (; i < t.size(); ++i) {
         char c = t[i];
-        if (c == 'u' || c == 'U') is_unsigned = true;
-        else if (c != 'l' && c != 'L') throw Unknown{};
+        if (c == 'u' || c == 'U')
+            is_unsigned = true;
+        else if (c != 'l' && c != 'L')
+            throw Unknown{};
     }
     return {true, is_unsigned || v > static_cast<uint64_t>(INT64_MAX), v};
 }
@@ -456,7 +470,8 @@ bool Checker::value_of(const std::vector<Token>& in, uint64_t& value) const {
     };
     auto defined = [&](const std::string& word) {
         auto it = macros_.find(word);
-        if (it == macros_.end() || it->second.state == Macro::Unknown) return Value{false, false, 0};
+        if (it == macros_.end() || it->second.state == Macro::Unknown)
+            return Value{false, false, 0};
         return Value{true, false, it->second.state == Macro::Undefined ? 0u : 1u};
     };
     std::set<std::string> hidden;
@@ -521,8 +536,8 @@ Tri Checker::condition(const std::string& d, size_t first, size_t last) const {
     if (d == "if" || d == "elif") {
         for (size_t k = first + 2; k < last; ++k)
             if (tokens_[k].kind == Kind::Ident && probes_files(tokens_[k].text))
-                fail_at(tokens_[k], quote(first, last) +
-                                        ": an estimator file may not look for other files");
+                fail_at(tokens_[k],
+                        quote(first, last) + ": an estimator file may not look for other files");
         return evaluate(first + 2, last);
     }
     Tri c = kMaybe;
@@ -564,29 +579,34 @@ void Checker::directive(size_t first, size_t last) {
         top.current = tri_and(tri_not(top.taken), c);
         return;
     }
-    if (reach == kNo) return;  // skipped, as a preprocessor skips it (C99 6.10p4)
+    if (reach == kNo) return;       // skipped, as a preprocessor skips it (C99 6.10p4)
     if (first + 1 == last) return;  // the null directive
-    if (!named) fail_at(hash, quote(first, last) + ": a line marker would make compiler messages "
-                                                   "name other files and lines");
+    if (!named)
+        fail_at(hash, quote(first, last) +
+                          ": a line marker would make compiler messages "
+                          "name other files and lines");
     if (reads_files(d)) {
         if (d == "include" && last == first + 3 && tokens_[first + 2].text == "\"api.cl\"") {
             blank_.push_back({orig_[hash.begin], orig_[tokens_[first + 2].end - 1] + 1});
             return;
         }
-        fail_at(hash, quote(first, last) + ": an estimator file may include only \"api.cl\" (the "
-                                           "kernel API, already in scope; docs/ESTIMATORS.md)");
+        fail_at(hash, quote(first, last) +
+                          ": an estimator file may include only \"api.cl\" (the "
+                          "kernel API, already in scope; docs/ESTIMATORS.md)");
     }
     if (d == "line")
         fail_at(hash, quote(first, last) +
                           ": #line would make compiler messages name other files and lines");
     if (d == "define" || d == "undef") {
-        if (first + 2 >= last || tokens_[first + 2].kind != Kind::Ident) return;  // for the compiler
+        if (first + 2 >= last || tokens_[first + 2].kind != Kind::Ident)
+            return;  // for the compiler
         Macro& m = macros_[tokens_[first + 2].text];
         if (reach == kMaybe) {
             m = Macro{Macro::Unknown, {}};
         } else if (d == "undef") {
             m = Macro{Macro::Undefined, {}};
-        } else if (first + 3 < last && tokens_[first + 3].text == "(" && !tokens_[first + 3].space) {
+        } else if (first + 3 < last && tokens_[first + 3].text == "(" &&
+                   !tokens_[first + 3].space) {
             m = Macro{Macro::Function, {}};
         } else {
             m = Macro{Macro::Object,
@@ -601,9 +621,10 @@ void Checker::directive(size_t first, size_t last) {
         return;
     }
     if (d == "error" || d == "warning") return;  // the compiler reports it, naming this line
-    fail_at(hash, quote(first, last) + ": not a directive an estimator file may use (#define, "
-                                       "#undef, #if, #ifdef, #ifndef, #elif, #else, #endif, "
-                                       "#pragma, #error, #warning)");
+    fail_at(hash, quote(first, last) +
+                      ": not a directive an estimator file may use (#define, "
+                      "#undef, #if, #ifdef, #ifndef, #elif, #else, #endif, "
+                      "#pragma, #error, #warning)");
 }
 
 void Checker::directives() {
@@ -632,8 +653,10 @@ void Checker::directives() {
                                            ": not a pragma an estimator file may use");
             }
         }
-        if (is_directive) directive(k, end);
-        else if (reach != kNo) code_.push_back(t);
+        if (is_directive)
+            directive(k, end);
+        else if (reach != kNo)
+            code_.push_back(t);
         k = end;
     }
     if (!stack_.empty()) {
@@ -648,10 +671,10 @@ namespace {
 // takes 4 elements' room); types it does not know count 16.
 size_t type_size(const std::string& type) {
     static const std::map<std::string, size_t> scalars = {
-        {"char", 1},  {"uchar", 1},  {"bool", 1},  {"short", 2},  {"ushort", 2}, {"half", 2},
-        {"int", 4},   {"uint", 4},   {"float", 4}, {"long", 8},   {"ulong", 8},  {"double", 8},
-        {"size_t", 8}, {"ptrdiff_t", 8}, {"intptr_t", 8}, {"uintptr_t", 8}, {"unsigned", 4},
-        {"signed", 4}};
+        {"char", 1},      {"uchar", 1},    {"bool", 1},   {"short", 2},     {"ushort", 2},
+        {"half", 2},      {"int", 4},      {"uint", 4},   {"float", 4},     {"long", 8},
+        {"ulong", 8},     {"double", 8},   {"size_t", 8}, {"ptrdiff_t", 8}, {"intptr_t", 8},
+        {"uintptr_t", 8}, {"unsigned", 4}, {"signed", 4}};
     if (auto it = scalars.find(type); it != scalars.end()) return it->second;
     size_t digits = type.size();
     while (digits > 0 && is_digit(type[digits - 1])) --digits;
@@ -666,14 +689,14 @@ size_t type_size(const std::string& type) {
 
 bool keyword(const std::string& w) {
     static const std::set<std::string> words = {
-        "return", "else", "case", "default", "goto", "sizeof", "do", "while", "if", "for",
-        "switch", "break", "continue", "typedef", "struct", "union", "enum", "vec_step"};
+        "return", "else",   "case",  "default",  "goto",    "sizeof", "do",    "while", "if",
+        "for",    "switch", "break", "continue", "typedef", "struct", "union", "enum",  "vec_step"};
     return words.count(w) > 0;
 }
 bool qualifier(const std::string& w) {
-    static const std::set<std::string> words = {
-        "const", "volatile", "private", "__private", "static", "register", "restrict",
-        "__restrict", "unsigned", "signed"};
+    static const std::set<std::string> words = {"const",    "volatile", "private",  "__private",
+                                                "static",   "register", "restrict", "__restrict",
+                                                "unsigned", "signed"};
     return words.count(w) > 0;
 }
 
@@ -691,8 +714,10 @@ void Checker::code(const std::string& required_function, UserSource& out) {
     int depth = 0;
     for (size_t k = 0; k < c.size(); ++k) {
         const std::string& t = c[k].text;
-        if (t == "{") ++depth;
-        else if (t == "}") depth = std::max(0, depth - 1);
+        if (t == "{")
+            ++depth;
+        else if (t == "}")
+            depth = std::max(0, depth - 1);
         if (depth != 0 || c[k].kind != Kind::Ident) continue;
         out.file_scope_names.emplace(t, line_of(orig_[c[k].begin]));
         if (t == "kernel" || t == "__kernel") {
@@ -710,16 +735,21 @@ void Checker::code(const std::string& required_function, UserSource& out) {
         size_t j = k + 1;
         int parens = 0;
         for (; j < c.size(); ++j) {
-            if (c[j].text == "(") ++parens;
-            else if (c[j].text == ")" && --parens == 0) break;
-            else if (c[j].text == "{" || c[j].text == "}" || c[j].text == ";") break;
+            if (c[j].text == "(")
+                ++parens;
+            else if (c[j].text == ")" && --parens == 0)
+                break;
+            else if (c[j].text == "{" || c[j].text == "}" || c[j].text == ";")
+                break;
         }
         if (j + 1 >= c.size() || c[j].text != ")" || c[j + 1].text != "{") continue;
         size_t end = j + 1;
         int braces = 0;
         for (; end < c.size(); ++end) {
-            if (c[end].text == "{") ++braces;
-            else if (c[end].text == "}" && --braces == 0) break;
+            if (c[end].text == "{")
+                ++braces;
+            else if (c[end].text == "}" && --braces == 0)
+                break;
         }
         by_name[t].push_back(functions.size());
         functions.push_back({k, j + 2, std::min(end, c.size())});
@@ -737,7 +767,7 @@ void Checker::code(const std::string& required_function, UserSource& out) {
                 edges.push_back({c[k].text, k});
     }
     // A cycle, found by depth-first search from each function in the file's order.
-    std::map<std::string, int> state;  // 0 new, 1 on the path, 2 done
+    std::map<std::string, int> state;                  // 0 new, 1 on the path, 2 done
     std::vector<std::pair<std::string, size_t>> path;  // function, the call it makes next
     for (const Function& f : functions) {
         const std::string& root = c[f.name].text;
@@ -761,8 +791,8 @@ void Checker::code(const std::string& required_function, UserSource& out) {
                 std::string through;
                 for (size_t k = from + 1; k < stack.size(); ++k)
                     through += (through.empty() ? "" : ", ") + stack[k].first;
-                const size_t call = stack.size() == from + 1 ? token
-                                                             : calls[callee][stack[from].second - 1].second;
+                const size_t call =
+                    stack.size() == from + 1 ? token : calls[callee][stack[from].second - 1].second;
                 fail_at(c[call], "'" + callee + "' calls itself" +
                                      (through.empty() ? "" : " (through " + through + ")") +
                                      ": OpenCL C forbids recursion (OpenCL C 1.2 sec. 6.9)");
@@ -804,8 +834,10 @@ void Checker::code(const std::string& required_function, UserSource& out) {
                     size_t close = j + 1;
                     int brackets = 1;
                     for (; close < f.body_end; ++close) {
-                        if (c[close].text == "[") ++brackets;
-                        else if (c[close].text == "]" && --brackets == 0) break;
+                        if (c[close].text == "[")
+                            ++brackets;
+                        else if (c[close].text == "]" && --brackets == 0)
+                            break;
                     }
                     if (close >= f.body_end) break;
                     // The size as an #if would read it, with the file's own macros.
@@ -817,8 +849,9 @@ void Checker::code(const std::string& required_function, UserSource& out) {
                     j = close + 1;
                 }
                 if (array && known) {
-                    const size_t bytes = size > (UINT64_MAX >> 1) / 16 ? (UINT64_MAX >> 1)
-                                                                        : size * (pointer ? 8 : element);
+                    const size_t bytes = size > (UINT64_MAX >> 1) / 16
+                                             ? (UINT64_MAX >> 1)
+                                             : size * (pointer ? 8 : element);
                     total = total > (UINT64_MAX >> 1) - bytes ? (UINT64_MAX >> 1) : total + bytes;
                     if (bytes >= largest) largest = bytes, largest_token = name;
                 }
@@ -826,8 +859,10 @@ void Checker::code(const std::string& required_function, UserSource& out) {
                 int nesting = 0;
                 while (j < f.body_end) {
                     const std::string& x = c[j].text;
-                    if (x == "(" || x == "[" || x == "{") ++nesting;
-                    else if (x == ")" || x == "]" || x == "}") --nesting;
+                    if (x == "(" || x == "[" || x == "{")
+                        ++nesting;
+                    else if (x == ")" || x == "]" || x == "}")
+                        --nesting;
                     if (nesting < 0 || (nesting == 0 && (x == "," || x == ";"))) break;
                     ++j;
                 }

@@ -34,8 +34,7 @@ const std::vector<EstimatorVariant> kEstimatorVariants = {
     reflected("light-area", "estimate_light_area", kUsesLights | kUsesLightSelection,
               "a light by --light-select and a uniform point on it, pdf pmf/area converted by "
               "cos_y/d^2"),
-    reflected("light-solid-angle", "estimate_light_solid_angle",
-              kUsesLights | kUsesLightSelection,
+    reflected("light-solid-angle", "estimate_light_solid_angle", kUsesLights | kUsesLightSelection,
               "a light by --light-select and a direction uniform in its spherical triangle (Arvo "
               "1995), area below 3e-4 sr"),
     reflected("mis", "estimate_mis",
@@ -118,8 +117,8 @@ RenderVariants resolve_variants(const RenderSettings& settings) {
     v.estimator = settings.estimator_file.empty()
                       ? find_row(kEstimatorVariants, settings.estimator, "estimator", "estimator")
                       : user_estimator_variant();
-    v.light_select = &find_row(kLightSelectVariants, settings.light_select, "light_select",
-                               "light selection");
+    v.light_select =
+        &find_row(kLightSelectVariants, settings.light_select, "light_select", "light selection");
     v.sampler = &find_row(kSamplerVariants, settings.sampler, "sampler", "sampler");
     v.mis_heuristic =
         &find_row(kMisHeuristicVariants, settings.mis_heuristic, "mis_heuristic", "heuristic");
@@ -137,7 +136,7 @@ std::string variant_program_options(const RenderVariants& v, bool microfacet, bo
     // Estimators that weigh no strategies all build with the first heuristic: one program
     // whatever --mis-heuristic says.
     options += std::string(" -D ") + (v.uses(kUsesMisHeuristic) ? v.mis_heuristic->macro
-                                                               : kMisHeuristicVariants[0].macro);
+                                                                : kMisHeuristicVariants[0].macro);
     if (microfacet && v.materials->macro) options += std::string(" -D ") + v.materials->macro;
     // Texture lookups and alpha tests only for a scene that has them (DESIGN.md "Radiometric
     // contract": model no more than a scene needs).
@@ -202,14 +201,15 @@ std::string variants_json() {
                               {"uses", uses_names(row.uses)},
                               {"description", row.description}});
     const EstimatorVariant user = user_estimator_variant();
-    nlohmann::json j = {
-        {"estimators", estimators},
-        {"light_select", option_rows(kLightSelectVariants)},
-        {"samplers", option_rows(kSamplerVariants)},
-        {"mis_heuristics", option_rows(kMisHeuristicVariants)},
-        {"materials", option_rows(kMaterialVariants)},
-        {"user_estimator",
-         {{"function", user.function}, {"kind", kind_name(user.kind)}, {"uses", uses_names(user.uses)}}}};
+    nlohmann::json j = {{"estimators", estimators},
+                        {"light_select", option_rows(kLightSelectVariants)},
+                        {"samplers", option_rows(kSamplerVariants)},
+                        {"mis_heuristics", option_rows(kMisHeuristicVariants)},
+                        {"materials", option_rows(kMaterialVariants)},
+                        {"user_estimator",
+                         {{"function", user.function},
+                          {"kind", kind_name(user.kind)},
+                          {"uses", uses_names(user.uses)}}}};
     return j.dump(2) + "\n";
 }
 

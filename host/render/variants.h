@@ -20,8 +20,8 @@ enum EstimatorUses : unsigned {
     kUsesLightSelection = 1u << 1,  // chooses among the lights with --light-select
     kUsesSky = 1u << 2,  // sees the uniform sky (--sky, --ao-distance); camera misses too. Set by
                          // the ambient kind, never by hand
-    kUsesMisHeuristic = 1u << 3,  // weights strategies with --mis-heuristic
-    kUsesBsdfSampling = 1u << 4,  // draws directions from the BSDF
+    kUsesMisHeuristic = 1u << 3,       // weights strategies with --mis-heuristic
+    kUsesBsdfSampling = 1u << 4,       // draws directions from the BSDF
     kUsesCorrelatedSamples = 1u << 5,  // a pixel's samples are correlated whatever the sampler
                                        // (the Fibonacci spiral): error bars need replicates
     kUsesSkyLight = 1u << 6,  // with --sky, sees the sky as a light at infinity (its directions
@@ -39,7 +39,7 @@ struct EstimatorVariant {
     const char* name;      // --estimator
     const char* function;  // the kernel function, compiled in as -D MCRT_ESTIMATE=<function>
     EstimatorKind kind;
-    unsigned uses;         // EstimatorUses bits, the kind's sky bit included
+    unsigned uses;  // EstimatorUses bits, the kind's sky bit included
     const char* description;
 };
 
@@ -123,10 +123,9 @@ RenderVariants resolve_variants(const RenderSettings& settings);
 // glTF model only); `single_sided`: a triangle whose back face is culled (-D MCRT_SINGLE_SIDED);
 // `environment_map`: a render with --env (-D MCRT_ENVIRONMENT_MAP); `punctual`: KHR_lights_punctual
 // lights (-D MCRT_PUNCTUAL).
-std::string variant_program_options(const RenderVariants& variants, bool microfacet,
-                                    bool textured, bool transmission = false,
-                                    bool single_sided = false, bool environment_map = false,
-                                    bool punctual = false);
+std::string variant_program_options(const RenderVariants& variants, bool microfacet, bool textured,
+                                    bool transmission = false, bool single_sided = false,
+                                    bool environment_map = false, bool punctual = false);
 
 // The rows' names, in table order (CLI11's IsMember, --help, the tests).
 template <typename Row>

@@ -7,7 +7,8 @@
 namespace mcrt {
 
 WorkQueue::WorkQueue(uint32_t pixels, uint32_t spp)
-    : pixels_(pixels), spp_(spp),
+    : pixels_(pixels),
+      spp_(spp),
       chunks_((spp + MCRT_SAMPLES_PER_CHUNK - 1) / MCRT_SAMPLES_PER_CHUNK) {}
 
 uint32_t WorkQueue::samples_in_chunk(uint32_t chunk) const {

@@ -22,7 +22,7 @@ struct WorkItem {
 };
 
 class WorkQueue {
-public:
+  public:
     WorkQueue(uint32_t pixels, uint32_t spp);
 
     // The next item of about target_samples samples (never fewer than one chunk of 64 pixels),
@@ -42,7 +42,7 @@ public:
     bool stopped() const;
     uint32_t samples_in_chunk(uint32_t chunk) const;
 
-private:
+  private:
     const uint32_t pixels_, spp_, chunks_;
     mutable std::mutex mutex_;
     std::condition_variable changed_;

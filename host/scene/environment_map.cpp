@@ -25,7 +25,8 @@ constexpr double kPi = 3.14159265358979323846;
 bool ends_with(const std::string& s, const std::string& tail) {
     if (s.size() < tail.size()) return false;
     std::string end = s.substr(s.size() - tail.size());
-    std::transform(end.begin(), end.end(), end.begin(), [](unsigned char c) { return std::tolower(c); });
+    std::transform(end.begin(), end.end(), end.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
     return end == tail;
 }
 
@@ -56,13 +57,15 @@ EnvironmentMap read_exr_map(const std::string& path) {
         // Channels of any pixel type (half or float) read into floats; the base pointer is
         // offset so that the data window's corner lands on texel 0 (OpenEXR "Reading and
         // Writing Image Files", Framebuffers).
-        char* base = reinterpret_cast<char*>(map.rgb.data()) -
-                     (ptrdiff_t(window.min.x) + ptrdiff_t(window.min.y) * width) * 3 * sizeof(float);
+        char* base =
+            reinterpret_cast<char*>(map.rgb.data()) -
+            (ptrdiff_t(window.min.x) + ptrdiff_t(window.min.y) * width) * 3 * sizeof(float);
         Imf::FrameBuffer frame;
         const char* names[3] = {"R", "G", "B"};
         for (int c = 0; c < 3; ++c) {
-            frame.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 3 * sizeof(float),
-                                              3 * sizeof(float) * size_t(width)));
+            frame.insert(names[c],
+                         Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 3 * sizeof(float),
+                                    3 * sizeof(float) * size_t(width)));
         }
         file.setFrameBuffer(frame);
         file.readPixels(window.min.y, window.max.y);
@@ -91,7 +94,8 @@ void hdr_skip(void* user, int n) { std::fseek(static_cast<HdrSource*>(user)->fil
 int hdr_eof(void* user) { return std::feof(static_cast<HdrSource*>(user)->file); }
 
 EnvironmentMap read_hdr_map(const std::string& path) {
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
+                                                         std::fclose);
     if (!file) throw InputError(path + ": cannot open environment map");
     const stbi_io_callbacks callbacks{hdr_read, hdr_skip, hdr_eof};
     HdrSource source{file.get(), false};
@@ -107,8 +111,10 @@ EnvironmentMap read_hdr_map(const std::string& path) {
     std::rewind(file.get());
     source.ran_out = false;
     std::unique_ptr<float, void (*)(void*)> pixels(
-        stbi_loadf_from_callbacks(&callbacks, &source, &width, &height, &channels, 3), stbi_image_free);
-    if (!pixels) throw InputError(path + ": cannot read .hdr environment map: " + stbi_failure_reason());
+        stbi_loadf_from_callbacks(&callbacks, &source, &width, &height, &channels, 3),
+        stbi_image_free);
+    if (!pixels)
+        throw InputError(path + ": cannot read .hdr environment map: " + stbi_failure_reason());
     if (source.ran_out) throw InputError(path + ": .hdr environment map is truncated");
     EnvironmentMap map;
     map.width = width;
@@ -133,9 +139,10 @@ EnvironmentMap load_environment_map(const std::string& path, float scale) {
         const float value = map.rgb[k];
         if (!std::isfinite(value) || value < 0.0f || double(value) * scale > kMaxRadiance) {
             const size_t texel = k / 3;
-            throw InputError(path + ": environment map texel (" + std::to_string(texel % map.width) +
-                             ", " + std::to_string(texel / map.width) + ") is " +
-                             std::to_string(value) + "; texels must be finite and non-negative");
+            throw InputError(path + ": environment map texel (" +
+                             std::to_string(texel % map.width) + ", " +
+                             std::to_string(texel / map.width) + ") is " + std::to_string(value) +
+                             "; texels must be finite and non-negative");
         }
         map.rgb[k] = value * scale;
         any_light = any_light || map.rgb[k] > 0.0f;

@@ -186,11 +186,11 @@ void GeometryImporter::add_primitive(const tinygltf::Primitive& primitive,
     // A strip or fan of fewer than 3 is as malformed as TRIANGLES of a count not a multiple of 3
     // (glTF 2.0 "Meshes": strips and fans make count − 2 triangles).
     if (mode != TINYGLTF_MODE_TRIANGLES && ids.size() < 3) {
-        diag_.fail(element, std::to_string(ids.size()) +
-                                (primitive.indices != -1 ? " indices" : " vertices") +
-                                " are fewer than one triangle's 3 (mode " +
-                                (mode == TINYGLTF_MODE_TRIANGLE_STRIP ? "TRIANGLE_STRIP" : "TRIANGLE_FAN") +
-                                ")");
+        diag_.fail(
+            element,
+            std::to_string(ids.size()) + (primitive.indices != -1 ? " indices" : " vertices") +
+                " are fewer than one triangle's 3 (mode " +
+                (mode == TINYGLTF_MODE_TRIANGLE_STRIP ? "TRIANGLE_STRIP" : "TRIANGLE_FAN") + ")");
     }
     const std::vector<uint32_t> corners = triangle_list(mode, ids);
     const size_t triangles = corners.size() / 3;

@@ -77,7 +77,8 @@ Scene import_default_scene(const tinygltf::Model& model, const std::string& path
     });
     geometry.finish();
     gltf::warn_open_volumes(scene, diag);
-    for (const tinygltf::Camera& camera : model.cameras) scene.gltf_camera_types.push_back(camera.type);
+    for (const tinygltf::Camera& camera : model.cameras)
+        scene.gltf_camera_types.push_back(camera.type);
     // The images the used materials' texture slots name, once the walk has found them all.
     scene.images = gltf::decode_images(model, textures.image_sources(), diag);
     return scene;

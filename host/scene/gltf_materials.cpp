@@ -1,6 +1,7 @@
 // glTF materials as mcrt's Material: the metallic-roughness factors (glTF 2.0 Appendix B),
 // emission with KHR_materials_emissive_strength, KHR_materials_specular, KHR_materials_ior,
-// KHR_materials_transmission and KHR_materials_volume, the alpha mode and the texture slots (gltf_textures.cpp); what is ignored warned.
+// KHR_materials_transmission and KHR_materials_volume, the alpha mode and the texture slots
+// (gltf_textures.cpp); what is ignored warned.
 #include "scene/gltf_materials.h"
 
 #include <algorithm>
@@ -136,8 +137,8 @@ void read_transmission(const tinygltf::Material& source, const std::string& elem
         diag.fail(element, "KHR_materials_volume.thicknessFactor must be a finite number >= 0");
     }
     material.volume = thickness > 0.0;
-    double distance = extension_number(*volume, "attenuationDistance",
-                                       std::numeric_limits<double>::infinity());
+    double distance =
+        extension_number(*volume, "attenuationDistance", std::numeric_limits<double>::infinity());
     if (std::isnan(distance)) {
         diag.fail(element, "KHR_materials_volume.attenuationDistance must be a number > 0");
     }

@@ -69,14 +69,14 @@ std::string one_line(const std::string& text) {
 struct FileAccess {
     enum class Origin { Disk, Bundle, Memory };
     Origin origin = Origin::Disk;
-    FileBundle* record = nullptr;         // Disk: keeps a copy of what is read
-    const FileBundle* bundle = nullptr;   // Bundle: read from here instead of the disk
-    std::string base_prefix;              // the scene's directory and "/"
+    FileBundle* record = nullptr;                    // Disk: keeps a copy of what is read
+    const FileBundle* bundle = nullptr;              // Bundle: read from here instead of the disk
+    std::string base_prefix;                         // the scene's directory and "/"
     std::map<std::string, gltf::UriTarget> targets;  // by the path tinygltf asks for
-    uint64_t image_bytes = 0;             // image files read so far
-    std::vector<std::string> files_read;  // external files, in the order read
-    std::string first_refusal;            // refusals of optional files (images) tinygltf drops
-    std::string size_refusal;             // a file of the wrong size, named by its element
+    uint64_t image_bytes = 0;                        // image files read so far
+    std::vector<std::string> files_read;             // external files, in the order read
+    std::string first_refusal;  // refusals of optional files (images) tinygltf drops
+    std::string size_refusal;   // a file of the wrong size, named by its element
 };
 
 // One file, from the bundle when there is one, else from the disk (recorded when asked).
@@ -101,9 +101,10 @@ bool read_file(FileAccess& access, const std::string& path, std::vector<unsigned
 // What a uri names: a buffer is read up to its byteLength ("Buffers": the resource MUST be at
 // least byteLength long, so a longer file is valid) and refused when shorter; an image file, whose
 // size nothing declares, within kMaxImageFileBytes. Both before any byte is read.
-bool read_target(FileAccess& access, const gltf::UriTarget& target,
-                 std::vector<unsigned char>& out, std::string& why) {
-    if (access.origin == FileAccess::Origin::Bundle) return read_file(access, target.path, out, why);
+bool read_target(FileAccess& access, const gltf::UriTarget& target, std::vector<unsigned char>& out,
+                 std::string& why) {
+    if (access.origin == FileAccess::Origin::Bundle)
+        return read_file(access, target.path, out, why);
     FileSizeLimits limits;
     if (target.buffer) {
         if (target.byte_length > kMaxFileBytes) {
@@ -113,7 +114,8 @@ bool read_target(FileAccess& access, const gltf::UriTarget& target,
         }
         limits.min_bytes = limits.read_bytes = target.byte_length;
     } else {
-        limits.max_bytes = std::min<uint64_t>(kMaxImageFileBytes, kMaxImageFilesBytes - access.image_bytes);
+        limits.max_bytes =
+            std::min<uint64_t>(kMaxImageFileBytes, kMaxImageFilesBytes - access.image_bytes);
     }
     if (!read_regular_file(target.path, out, why, limits)) {
         const bool size = why.compare(0, 6, "holds ") == 0;
@@ -148,8 +150,9 @@ bool file_read(std::vector<unsigned char>* out, std::string* error, const std::s
     std::string why;
     const auto target = access->targets.find(path);
     const std::string& read_path = target != access->targets.end() ? target->second.path : path;
-    const bool ok = target != access->targets.end() ? read_target(*access, target->second, *out, why)
-                                                    : read_file(*access, path, *out, why);
+    const bool ok = target != access->targets.end()
+                        ? read_target(*access, target->second, *out, why)
+                        : read_file(*access, path, *out, why);
     if (!ok) {
         if (error) *error = why;
         if (access->first_refusal.empty()) access->first_refusal = read_path + ": " + why;
@@ -185,7 +188,8 @@ tinygltf::Model parse_gltf(const std::string& name, const std::vector<unsigned c
     const char* json = reinterpret_cast<const char*>(bytes.data());
     size_t json_size = bytes.size();
     const bool has_json = !binary || glb_json_chunk(bytes.data(), bytes.size(), &json, &json_size);
-    if (has_json) check_gltf_property_types(name, reinterpret_cast<const unsigned char*>(json), json_size);
+    if (has_json)
+        check_gltf_property_types(name, reinterpret_cast<const unsigned char*>(json), json_size);
 
     access.base_prefix = base_dir.empty() || base_dir.back() == '/' ? base_dir : base_dir + "/";
     if (has_json) access.targets = gltf::scan_uris(name, json, json_size, base_dir);

@@ -18,12 +18,12 @@ using nlohmann::json;
 // and any integer inside an extension becomes a tinygltf::Value of `int` (ExtensionNumber). Every
 // integer kind takes JSON integers alone: tinygltf drops 1.0 or 1e0 as if the property were absent.
 enum class Kind {
-    Int32,           // an enumeration tinygltf keeps in an int: mode, wrapS, magFilter, ...
-    Index,           // a glTF id (or an int count or offset): 0 to INT_MAX
-    Unsigned,        // a size_t of tinygltf: byteOffset, byteLength, byteStride, count
-    Number,          // a double of tinygltf
-    ExtensionNumber, // a number of an extension: no integer beyond int range (other values,
-                     // strings included, are left to the code that reads the extension)
+    Int32,            // an enumeration tinygltf keeps in an int: mode, wrapS, magFilter, ...
+    Index,            // a glTF id (or an int count or offset): 0 to INT_MAX
+    Unsigned,         // a size_t of tinygltf: byteOffset, byteLength, byteStride, count
+    Number,           // a double of tinygltf
+    ExtensionNumber,  // a number of an extension: no integer beyond int range (other values,
+                      // strings included, are left to the code that reads the extension)
     String,
     Boolean,
     Object,
@@ -52,40 +52,62 @@ bool has_kind(const json& v, Kind kind) {
         return true;
     };
     switch (kind) {
-        case Kind::Int32: return integer_within(v, kIntMin, kIntMax);
-        case Kind::Index: return integer_within(v, 0, kIntMax);
-        case Kind::Unsigned: return v.is_number_unsigned();
-        case Kind::Number: return v.is_number();
+        case Kind::Int32:
+            return integer_within(v, kIntMin, kIntMax);
+        case Kind::Index:
+            return integer_within(v, 0, kIntMax);
+        case Kind::Unsigned:
+            return v.is_number_unsigned();
+        case Kind::Number:
+            return v.is_number();
         case Kind::ExtensionNumber:
             return !v.is_number_integer() || integer_within(v, kIntMin, kIntMax);
-        case Kind::String: return v.is_string();
-        case Kind::Boolean: return v.is_boolean();
-        case Kind::Object: return v.is_object();
-        case Kind::IndexArray: return all(Kind::Index);
-        case Kind::NumberArray: return all(Kind::Number);
-        case Kind::ExtensionNumberArray: return !v.is_array() || all(Kind::ExtensionNumber);
-        case Kind::StringArray: return all(Kind::String);
+        case Kind::String:
+            return v.is_string();
+        case Kind::Boolean:
+            return v.is_boolean();
+        case Kind::Object:
+            return v.is_object();
+        case Kind::IndexArray:
+            return all(Kind::Index);
+        case Kind::NumberArray:
+            return all(Kind::Number);
+        case Kind::ExtensionNumberArray:
+            return !v.is_array() || all(Kind::ExtensionNumber);
+        case Kind::StringArray:
+            return all(Kind::String);
     }
     return false;
 }
 
 const char* kind_name(Kind kind) {
     switch (kind) {
-        case Kind::Int32: return "an integer from -2147483648 to 2147483647";
-        case Kind::Index: return "an integer from 0 to 2147483647";
-        case Kind::Unsigned: return "a non-negative integer";
-        case Kind::Number: return "a number";
+        case Kind::Int32:
+            return "an integer from -2147483648 to 2147483647";
+        case Kind::Index:
+            return "an integer from 0 to 2147483647";
+        case Kind::Unsigned:
+            return "a non-negative integer";
+        case Kind::Number:
+            return "a number";
         case Kind::ExtensionNumber:
             return "a number, as an integer from -2147483648 to 2147483647 (tinygltf keeps an "
                    "extension's integers in 32 bits: write a larger one with a fraction, as "
                    "4294967296.0)";
-        case Kind::String: return "a string";
-        case Kind::Boolean: return "a boolean";
-        case Kind::Object: return "an object";
-        case Kind::IndexArray: return "an array of integers from 0 to 2147483647";
-        case Kind::NumberArray: return "an array of numbers";
-        case Kind::ExtensionNumberArray: return "an array of numbers";  // named per element
-        case Kind::StringArray: return "an array of strings";
+        case Kind::String:
+            return "a string";
+        case Kind::Boolean:
+            return "a boolean";
+        case Kind::Object:
+            return "an object";
+        case Kind::IndexArray:
+            return "an array of integers from 0 to 2147483647";
+        case Kind::NumberArray:
+            return "an array of numbers";
+        case Kind::ExtensionNumberArray:
+            return "an array of numbers";  // named per element
+        case Kind::StringArray:
+            return "an array of strings";
     }
     return "?";
 }
@@ -93,11 +115,16 @@ const char* kind_name(Kind kind) {
 // The kind of each element of an array kind; Kind::Object (none) for the others.
 Kind item_kind(Kind kind) {
     switch (kind) {
-        case Kind::IndexArray: return Kind::Index;
-        case Kind::NumberArray: return Kind::Number;
-        case Kind::ExtensionNumberArray: return Kind::ExtensionNumber;
-        case Kind::StringArray: return Kind::String;
-        default: return Kind::Object;
+        case Kind::IndexArray:
+            return Kind::Index;
+        case Kind::NumberArray:
+            return Kind::Number;
+        case Kind::ExtensionNumberArray:
+            return Kind::ExtensionNumber;
+        case Kind::StringArray:
+            return Kind::String;
+        default:
+            return Kind::Object;
     }
 }
 
@@ -174,9 +201,12 @@ class Checker {
     // "Texture Data": a textureInfo, whose index tinygltf leaves at −1 (no texture) when it is
     // missing, and its KHR_texture_transform.
     void texture_info(const json& object, const std::string& where) const {
-        properties(object, where, {{"index", Kind::Index}, {"texCoord", Kind::Index},
-                                   {"scale", Kind::Number}, {"strength", Kind::Number},
-                                   {"extensions", Kind::Object}});
+        properties(object, where,
+                   {{"index", Kind::Index},
+                    {"texCoord", Kind::Index},
+                    {"scale", Kind::Number},
+                    {"strength", Kind::Number},
+                    {"extensions", Kind::Object}});
         if (!object.contains("index")) {
             throw InputError(name_ + ": " + where + ".index: required, an integer");
         }
@@ -185,7 +215,8 @@ class Checker {
                 properties(*t, where + ".extensions.KHR_texture_transform",
                            {{"offset", Kind::ExtensionNumberArray},
                             {"rotation", Kind::ExtensionNumber},
-                            {"scale", Kind::ExtensionNumberArray}, {"texCoord", Kind::Index}});
+                            {"scale", Kind::ExtensionNumberArray},
+                            {"texCoord", Kind::Index}});
         }
     }
 
@@ -204,25 +235,36 @@ void check_gltf_property_types(const std::string& name, const unsigned char* dat
     const json root = json::parse(data, data + size, nullptr, false);
     if (root.is_discarded() || !root.is_object()) return;  // tinygltf reports it
     const Checker c(name);
-    c.properties(root, "glTF", {{"scene", Kind::Index}, {"asset", Kind::Object},
-                                {"extensionsRequired", Kind::StringArray},
-                                {"extensionsUsed", Kind::StringArray}});
+    c.properties(root, "glTF",
+                 {{"scene", Kind::Index},
+                  {"asset", Kind::Object},
+                  {"extensionsRequired", Kind::StringArray},
+                  {"extensionsUsed", Kind::StringArray}});
     if (const auto asset = root.find("asset"); asset != root.end())
         c.properties(*asset, "asset", {{"version", Kind::String}, {"minVersion", Kind::String}});
     c.array_of_objects(root, "scenes", "", [&](const json& s, const std::string& at) {
         c.properties(s, at, {{"nodes", Kind::IndexArray}});
     });
     c.array_of_objects(root, "nodes", "", [&](const json& n, const std::string& at) {
-        c.properties(n, at, {{"mesh", Kind::Index}, {"camera", Kind::Index},
-                             {"skin", Kind::Index}, {"children", Kind::IndexArray},
-                             {"matrix", Kind::NumberArray}, {"translation", Kind::NumberArray},
-                             {"rotation", Kind::NumberArray}, {"scale", Kind::NumberArray},
-                             {"weights", Kind::NumberArray}, {"extensions", Kind::Object}});
+        c.properties(n, at,
+                     {{"mesh", Kind::Index},
+                      {"camera", Kind::Index},
+                      {"skin", Kind::Index},
+                      {"children", Kind::IndexArray},
+                      {"matrix", Kind::NumberArray},
+                      {"translation", Kind::NumberArray},
+                      {"rotation", Kind::NumberArray},
+                      {"scale", Kind::NumberArray},
+                      {"weights", Kind::NumberArray},
+                      {"extensions", Kind::Object}});
     });
     c.array_of_objects(root, "meshes", "", [&](const json& m, const std::string& at) {
         c.array_of_objects(m, "primitives", at, [&](const json& p, const std::string& pat) {
-            c.properties(p, pat, {{"attributes", Kind::Object}, {"indices", Kind::Index},
-                                  {"material", Kind::Index}, {"mode", Kind::Int32}});
+            c.properties(p, pat,
+                         {{"attributes", Kind::Object},
+                          {"indices", Kind::Index},
+                          {"material", Kind::Index},
+                          {"mode", Kind::Int32}});
             if (const auto a = p.find("attributes"); a != p.end())
                 c.index_values(*a, pat + ".attributes");
             c.array_of_objects(p, "targets", pat, [&](const json& t, const std::string& tat) {
@@ -231,18 +273,25 @@ void check_gltf_property_types(const std::string& name, const unsigned char* dat
         });
     });
     c.array_of_objects(root, "materials", "", [&](const json& m, const std::string& at) {
-        c.properties(m, at, {{"pbrMetallicRoughness", Kind::Object},
-                             {"emissiveFactor", Kind::NumberArray}, {"doubleSided", Kind::Boolean},
-                             {"alphaMode", Kind::String}, {"alphaCutoff", Kind::Number},
-                             {"normalTexture", Kind::Object}, {"occlusionTexture", Kind::Object},
-                             {"emissiveTexture", Kind::Object}, {"extensions", Kind::Object}});
+        c.properties(m, at,
+                     {{"pbrMetallicRoughness", Kind::Object},
+                      {"emissiveFactor", Kind::NumberArray},
+                      {"doubleSided", Kind::Boolean},
+                      {"alphaMode", Kind::String},
+                      {"alphaCutoff", Kind::Number},
+                      {"normalTexture", Kind::Object},
+                      {"occlusionTexture", Kind::Object},
+                      {"emissiveTexture", Kind::Object},
+                      {"extensions", Kind::Object}});
         for (const char* slot : {"normalTexture", "occlusionTexture", "emissiveTexture"})
             if (const auto info = m.find(slot); info != m.end())
                 c.texture_info(*info, at + "." + slot);
         if (const auto pbr = m.find("pbrMetallicRoughness"); pbr != m.end()) {
             c.properties(*pbr, at + ".pbrMetallicRoughness",
-                         {{"baseColorFactor", Kind::NumberArray}, {"metallicFactor", Kind::Number},
-                          {"roughnessFactor", Kind::Number}, {"baseColorTexture", Kind::Object},
+                         {{"baseColorFactor", Kind::NumberArray},
+                          {"metallicFactor", Kind::Number},
+                          {"roughnessFactor", Kind::Number},
+                          {"baseColorTexture", Kind::Object},
                           {"metallicRoughnessTexture", Kind::Object}});
             for (const char* slot : {"baseColorTexture", "metallicRoughnessTexture"})
                 if (const auto info = pbr->find(slot); info != pbr->end())
@@ -256,8 +305,9 @@ void check_gltf_property_types(const std::string& name, const unsigned char* dat
                      });
             c.object(*ext, "KHR_materials_transmission", ext_at,
                      [&](const json& e, const std::string& eat) {
-                         c.properties(e, eat, {{"transmissionFactor", Kind::ExtensionNumber},
-                                               {"transmissionTexture", Kind::Object}});
+                         c.properties(e, eat,
+                                      {{"transmissionFactor", Kind::ExtensionNumber},
+                                       {"transmissionTexture", Kind::Object}});
                          if (const auto info = e.find("transmissionTexture"); info != e.end())
                              c.texture_info(*info, eat + ".transmissionTexture");
                      });
@@ -270,29 +320,41 @@ void check_gltf_property_types(const std::string& name, const unsigned char* dat
         }
     });
     c.array_of_objects(root, "textures", "", [&](const json& t, const std::string& at) {
-        c.properties(t, at, {{"sampler", Kind::Index}, {"source", Kind::Index},
-                             {"extensions", Kind::Object}});
+        c.properties(
+            t, at,
+            {{"sampler", Kind::Index}, {"source", Kind::Index}, {"extensions", Kind::Object}});
     });
     c.array_of_objects(root, "samplers", "", [&](const json& t, const std::string& at) {
-        c.properties(t, at, {{"magFilter", Kind::Int32}, {"minFilter", Kind::Int32},
-                             {"wrapS", Kind::Int32}, {"wrapT", Kind::Int32}});
+        c.properties(t, at,
+                     {{"magFilter", Kind::Int32},
+                      {"minFilter", Kind::Int32},
+                      {"wrapS", Kind::Int32},
+                      {"wrapT", Kind::Int32}});
     });
     c.array_of_objects(root, "images", "", [&](const json& i, const std::string& at) {
-        c.properties(i, at, {{"uri", Kind::String}, {"mimeType", Kind::String},
-                             {"bufferView", Kind::Index}});
+        c.properties(
+            i, at,
+            {{"uri", Kind::String}, {"mimeType", Kind::String}, {"bufferView", Kind::Index}});
     });
     c.array_of_objects(root, "accessors", "", [&](const json& a, const std::string& at) {
-        c.properties(a, at, {{"bufferView", Kind::Index}, {"byteOffset", Kind::Unsigned},
-                             {"componentType", Kind::Unsigned}, {"count", Kind::Unsigned},
-                             {"type", Kind::String}, {"normalized", Kind::Boolean},
-                             {"sparse", Kind::Object}});
+        c.properties(a, at,
+                     {{"bufferView", Kind::Index},
+                      {"byteOffset", Kind::Unsigned},
+                      {"componentType", Kind::Unsigned},
+                      {"count", Kind::Unsigned},
+                      {"type", Kind::String},
+                      {"normalized", Kind::Boolean},
+                      {"sparse", Kind::Object}});
         // "Sparse Accessors": tinygltf keeps count and the offsets in an int.
         c.object(a, "sparse", at, [&](const json& s, const std::string& sat) {
-            c.properties(s, sat, {{"count", Kind::Index}, {"indices", Kind::Object},
-                                  {"values", Kind::Object}});
+            c.properties(
+                s, sat,
+                {{"count", Kind::Index}, {"indices", Kind::Object}, {"values", Kind::Object}});
             c.object(s, "indices", sat, [&](const json& i, const std::string& iat) {
-                c.properties(i, iat, {{"bufferView", Kind::Index}, {"byteOffset", Kind::Index},
-                                      {"componentType", Kind::Int32}});
+                c.properties(i, iat,
+                             {{"bufferView", Kind::Index},
+                              {"byteOffset", Kind::Index},
+                              {"componentType", Kind::Int32}});
             });
             c.object(s, "values", sat, [&](const json& v, const std::string& vat) {
                 c.properties(v, vat, {{"bufferView", Kind::Index}, {"byteOffset", Kind::Index}});
@@ -300,9 +362,12 @@ void check_gltf_property_types(const std::string& name, const unsigned char* dat
         });
     });
     c.array_of_objects(root, "bufferViews", "", [&](const json& v, const std::string& at) {
-        c.properties(v, at, {{"buffer", Kind::Index}, {"byteOffset", Kind::Unsigned},
-                             {"byteLength", Kind::Unsigned}, {"byteStride", Kind::Unsigned},
-                             {"target", Kind::Int32}});
+        c.properties(v, at,
+                     {{"buffer", Kind::Index},
+                      {"byteOffset", Kind::Unsigned},
+                      {"byteLength", Kind::Unsigned},
+                      {"byteStride", Kind::Unsigned},
+                      {"target", Kind::Int32}});
     });
     c.array_of_objects(root, "buffers", "", [&](const json& b, const std::string& at) {
         c.properties(b, at, {{"byteLength", Kind::Unsigned}, {"uri", Kind::String}});
@@ -311,13 +376,17 @@ void check_gltf_property_types(const std::string& name, const unsigned char* dat
         c.properties(cam, at, {{"type", Kind::String}, {"perspective", Kind::Object}});
         if (const auto p = cam.find("perspective"); p != cam.end())
             c.properties(*p, at + ".perspective",
-                         {{"yfov", Kind::Number}, {"znear", Kind::Number}, {"zfar", Kind::Number},
+                         {{"yfov", Kind::Number},
+                          {"znear", Kind::Number},
+                          {"zfar", Kind::Number},
                           {"aspectRatio", Kind::Number}});
     });
     // Skins and animations are ignored (one warning), but their indices are tinygltf's ints too.
     c.array_of_objects(root, "skins", "", [&](const json& s, const std::string& at) {
-        c.properties(s, at, {{"joints", Kind::IndexArray}, {"skeleton", Kind::Index},
-                             {"inverseBindMatrices", Kind::Index}});
+        c.properties(s, at,
+                     {{"joints", Kind::IndexArray},
+                      {"skeleton", Kind::Index},
+                      {"inverseBindMatrices", Kind::Index}});
     });
     c.array_of_objects(root, "animations", "", [&](const json& a, const std::string& at) {
         c.array_of_objects(a, "channels", at, [&](const json& ch, const std::string& cat) {

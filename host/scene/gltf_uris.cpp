@@ -71,7 +71,8 @@ void scan_array(const std::string& name, const json& root, const char* key, bool
         target.buffer = buffers;
         if (buffers) {
             const auto length = item.find("byteLength");
-            if (length == item.end() || !length->is_number_unsigned()) continue;  // tinygltf refuses
+            if (length == item.end() || !length->is_number_unsigned())
+                continue;  // tinygltf refuses
             target.byte_length = length->get<uint64_t>();
         }
         targets.emplace(tinygltf_path(base_dir, target.uri), std::move(target));
@@ -104,7 +105,8 @@ std::string uri_scheme(const std::string& uri) {
         const unsigned char c = static_cast<unsigned char>(uri[i]);
         if (c == ':') {
             std::string scheme = uri.substr(0, i);
-            for (char& s : scheme) s = static_cast<char>(std::tolower(static_cast<unsigned char>(s)));
+            for (char& s : scheme)
+                s = static_cast<char>(std::tolower(static_cast<unsigned char>(s)));
             return scheme;
         }
         if (!std::isalnum(c) && c != '+' && c != '-' && c != '.') return {};

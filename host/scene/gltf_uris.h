@@ -12,11 +12,11 @@ namespace mcrt::gltf {
 
 // One external file a uri names.
 struct UriTarget {
-    std::string element;        // "buffer 0", "image 2"
-    std::string uri;            // as written in the file
-    std::string path;           // the file it names: percent-decoded, resolved
-    bool buffer = false;        // a buffer, whose byteLength is known
-    uint64_t byte_length = 0;   // buffers: the declared byteLength
+    std::string element;       // "buffer 0", "image 2"
+    std::string uri;           // as written in the file
+    std::string path;          // the file it names: percent-decoded, resolved
+    bool buffer = false;       // a buffer, whose byteLength is known
+    uint64_t byte_length = 0;  // buffers: the declared byteLength
 };
 
 // The path that tinygltf hands to its file callbacks for `uri` (joined to `base_dir` after its

@@ -31,10 +31,11 @@ void warn_open_volumes(const Scene& scene, Diagnostics& diag) {
         for (const auto& [edge, count] : edges) open += count % 2;
         if (open > 0) {
             diag.warn_once("open-volume-" + std::to_string(m),
-                           "material \"" + material.name + "\": KHR_materials_volume on a surface "
-                               "that is not closed (" + std::to_string(open) + " of its " +
-                               std::to_string(edges.size()) + " edges bound an odd number of its " +
-                               std::to_string(triangles) +
+                           "material \"" + material.name +
+                               "\": KHR_materials_volume on a surface "
+                               "that is not closed (" +
+                               std::to_string(open) + " of its " + std::to_string(edges.size()) +
+                               " edges bound an odd number of its " + std::to_string(triangles) +
                                " triangles): a ray may enter and not leave it; light through it "
                                "is attenuated over the rest of its way");
         }

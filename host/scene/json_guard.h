@@ -1,5 +1,6 @@
 // A bound on JSON nesting checked before tinygltf parses the text: its recursive conversion
-// overflows the call stack near 20,000 levels (ROBUSTNESS.md "Inputs that hang or crash the loader").
+// overflows the call stack near 20,000 levels (ROBUSTNESS.md "Inputs that hang or crash the
+// loader").
 #pragma once
 
 #include <cstddef>

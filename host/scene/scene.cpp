@@ -1,9 +1,9 @@
 // Scene queries: bounds, the emissive triangles and the bench camera (DESIGN.md).
 #include "scene/scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <glm/gtc/constants.hpp>
-#include <algorithm>
 #include <limits>
 
 #include "scene/texture_lookup.h"
@@ -42,10 +42,9 @@ double covered_texels(const Scene& scene, size_t t, const TextureRef& ref) {
 // emitted power that light selection follows (DESIGN.md "Radiometric contract").
 double textured_emission_mean(const Scene& scene, size_t t, const Material& m) {
     if (scene.texcoords.empty()) return 1.0;
-    const double texels = std::max(covered_texels(scene, t, m.emissive_texture),
-                                   m.alpha_mode == AlphaMode::Opaque
-                                       ? 0.0
-                                       : covered_texels(scene, t, m.base_color_texture));
+    const double texels = std::max(
+        covered_texels(scene, t, m.emissive_texture),
+        m.alpha_mode == AlphaMode::Opaque ? 0.0 : covered_texels(scene, t, m.base_color_texture));
     const int n = int(std::ceil(std::sqrt(std::clamp(4.0 * texels, 1.0, 65536.0))));
     const glm::vec3 Le = m.emission;
     const double Le_luminance = luminance(Le);

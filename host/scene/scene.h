@@ -4,11 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <limits>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "scene/punctual_light.h"
 
@@ -22,7 +21,7 @@ enum class TextureWrap : uint8_t { Repeat, ClampToEdge, MirroredRepeat };
 // slot that reads it says which), row 0 the image's top row, where texture coordinate v = 0 lies
 // (glTF 2.0 "Images"). Grey, grey+alpha and RGB images are widened (alpha 255 when absent).
 struct TextureImage {
-    std::string name;           // its uri or "image N"
+    std::string name;  // its uri or "image N"
     uint32_t width = 0, height = 0;
     std::vector<uint8_t> rgba;  // width × height × 4 bytes, row by row
 };
@@ -30,8 +29,8 @@ struct TextureImage {
 // One texture slot of a material (glTF 2.0 "textureInfo" with its texture's sampler and
 // KHR_texture_transform): which image, how it is read, with which texture coordinates.
 struct TextureRef {
-    int32_t image = -1;     // index into Scene::images; −1: the slot is empty
-    bool srgb = false;      // baseColor and emissive hold sRGB-encoded values; others linear
+    int32_t image = -1;  // index into Scene::images; −1: the slot is empty
+    bool srgb = false;   // baseColor and emissive hold sRGB-encoded values; others linear
     TextureWrap wrap_s = TextureWrap::Repeat, wrap_t = TextureWrap::Repeat;
     bool linear = true;     // the sampler's magFilter: LINEAR (default) or NEAREST
     uint32_t texcoord = 0;  // TEXCOORD_n, 0 or 1 (KHR_texture_transform's texCoord applied)
@@ -51,12 +50,12 @@ enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
 // specification's defaults (metallic 1, specular 1) itself.
 struct Material {
     std::string name;
-    glm::vec3 albedo{1.0f};    // baseColorFactor.rgb (glTF default: white)
-    glm::vec3 emission{0.0f};  // Le = emissiveFactor × KHR_materials_emissive_strength
-    bool double_sided = false; // emits (and is shaded) on both faces
-    float metallic = 0.0f;     // metallicFactor, [0, 1]
-    float roughness = 1.0f;    // roughnessFactor, [0, 1]; GGX α = roughness²
-    float specular = 0.0f;     // KHR_materials_specular.specularFactor, [0, 1]; glTF default 1
+    glm::vec3 albedo{1.0f};     // baseColorFactor.rgb (glTF default: white)
+    glm::vec3 emission{0.0f};   // Le = emissiveFactor × KHR_materials_emissive_strength
+    bool double_sided = false;  // emits (and is shaded) on both faces
+    float metallic = 0.0f;      // metallicFactor, [0, 1]
+    float roughness = 1.0f;     // roughnessFactor, [0, 1]; GGX α = roughness²
+    float specular = 0.0f;      // KHR_materials_specular.specularFactor, [0, 1]; glTF default 1
     glm::vec3 specular_color{1.0f};  // KHR_materials_specular.specularColorFactor, ≥ 0
     // KHR_materials_ior: the dielectric's F0 = ((ior − 1)/(ior + 1))², 0.04 at the default 1.5;
     // ior is ≥ 1, or exactly 0, the extension's specular-glossiness mode (F = 1 everywhere).
@@ -69,9 +68,9 @@ struct Material {
     bool volume = false;
     glm::vec3 attenuation_color{1.0f};  // attenuationColor, [0, 1]
     float attenuation_distance = std::numeric_limits<float>::infinity();  // > 0; ∞: no loss
-    float alpha = 1.0f;        // baseColorFactor.a, [0, 1]
+    float alpha = 1.0f;  // baseColorFactor.a, [0, 1]
     AlphaMode alpha_mode = AlphaMode::Opaque;
-    float alpha_cutoff = 0.5f; // MASK only
+    float alpha_cutoff = 0.5f;  // MASK only
     // Texture slots; each multiplies its factor (glTF 2.0 "Metallic-Roughness Material").
     TextureRef base_color_texture;          // sRGB; RGB × albedo, A × alpha
     TextureRef metallic_roughness_texture;  // linear; B × metallic, G × roughness
@@ -84,14 +83,12 @@ struct Material {
     // query must test (MASK, BLEND).
     bool textured() const {
         return base_color_texture.used() || metallic_roughness_texture.used() ||
-               normal_texture.used() || emissive_texture.used() ||
-               transmission_texture.used() || alpha_mode != AlphaMode::Opaque;
+               normal_texture.used() || emissive_texture.used() || transmission_texture.used() ||
+               alpha_mode != AlphaMode::Opaque;
     }
 
     // Exactly the Lambertian albedo/π: no metal, and no specular layer on the dielectric.
-    bool lambertian() const {
-        return metallic == 0.0f && specular == 0.0f && transmission == 0.0f;
-    }
+    bool lambertian() const { return metallic == 0.0f && specular == 0.0f && transmission == 0.0f; }
 };
 
 // KHR_materials_ior's dielectric F0 = ((ior − 1)/(ior + 1))², in double and rounded once: exactly
@@ -109,8 +106,8 @@ inline glm::dvec3 volume_attenuation(const Material& m) {
     if (!std::isfinite(m.attenuation_distance)) return a;
     for (int c = 0; c < 3; ++c) {
         const double color = m.attenuation_color[c];
-        a[c] = color > 0.0 ? std::min(-std::log2(color) / double(m.attenuation_distance), 1e30)
-                           : 1e30;
+        a[c] =
+            color > 0.0 ? std::min(-std::log2(color) / double(m.attenuation_distance), 1e30) : 1e30;
     }
     return a;
 }
@@ -137,7 +134,7 @@ struct Scene {
     std::vector<Material> materials;
     std::vector<Camera> cameras;  // perspective camera nodes, in default-scene traversal order
     std::vector<std::string> gltf_camera_types;  // per glTF camera: "perspective", "orthographic"
-    std::vector<TextureImage> images;  // those the materials' texture slots name
+    std::vector<TextureImage> images;            // those the materials' texture slots name
     std::vector<glm::vec4> texcoords;  // per corner: .xy TEXCOORD_0, .zw TEXCOORD_1 (0 absent)
     // Per corner, world space, for materials with a normal texture (zero for the others): the
     // unit vertex normal (the face's where the primitive has none) and the unit tangent with
@@ -159,7 +156,7 @@ struct Scene {
 struct EmissiveTriangle {
     uint32_t triangle;  // index into Scene
     float area;
-    float power;        // luminance(Le) × area × π, ×2 when double-sided
+    float power;  // luminance(Le) × area × π, ×2 when double-sided
 };
 
 // Emissive triangles of the scene; zero-area (degenerate) and zero-radiance ones are dropped.

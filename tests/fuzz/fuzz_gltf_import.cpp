@@ -1,8 +1,9 @@
 // libFuzzer target: the bytes of a .gltf or .glb file through mcrt's glTF import, as
-// `mcrt render` loads a scene, then through the host's BVH build and light distributions. Refusing a file (InputError) is the expected outcome for most
-// inputs; anything else escaping is a crash, and so is an imported scene that breaks the
-// contract the renderer relies on (finite positions, in-range materials, finite emission,
-// rigid cameras with yfov in (0, pi)), which the checks below turn into an abort.
+// `mcrt render` loads a scene, then through the host's BVH build and light distributions. Refusing
+// a file (InputError) is the expected outcome for most inputs; anything else escaping is a crash,
+// and so is an imported scene that breaks the contract the renderer relies on (finite positions,
+// in-range materials, finite emission, rigid cameras with yfov in (0, pi)), which the checks below
+// turn into an abort.
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
