@@ -406,7 +406,8 @@ def parse_args(argv=None):
     p.add_argument("--render-options", type=shlex.split, default=[],
                    help="more `mcrt render` options for every render and the auto reference, "
                         "one string, e.g. \"--env sky.hdr --env-rotate 30\" (in the "
-                        "reference's settings and cache key, reference.json and the titles)")
+                        "reference's settings and cache key, reference.json and the titles); a single word starting with - as "
+                        "--render-options=--env-rotate=30")
     p.add_argument("--out", type=mcrt_run.output_directory, required=True, help="output directory")
     p.add_argument("--quick", action="store_true",
                    help="32×32 image, spp 1,4,16 unless given, 1 repeat, 512 spp reference")
