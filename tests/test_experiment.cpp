@@ -138,8 +138,8 @@ TEST_CASE("experiment harness: --render-options --env reaches the reference and 
     TempDir scratch("mcrt-experiment-env");
     require_python_modules(scratch.path());
     ProcessResult maps = run_process(
-        kPython, {std::string(MCRT_SOURCE_DIR) + "/scripts/scenes/make_sky_maps.py",
-                  scratch / "sky"},
+        kPython,
+        {std::string(MCRT_SOURCE_DIR) + "/scripts/scenes/make_sky_maps.py", scratch / "sky"},
         scratch.path(), 120.0);
     INFO("make_sky_maps.py: " << maps.err);
     REQUIRE(maps.exit_code == 0);
@@ -147,9 +147,23 @@ TEST_CASE("experiment harness: --render-options --env reaches the reference and 
 
     auto run = [&](const std::string& name, std::vector<std::string> more) {
         std::vector<std::string> arguments = {
-            script_path(), std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf", "--estimators",
-            "light-area", "--spp", "4", "--quick", "--reference-spp", "16", "--materials", "lambert",
-            "--reference-cache", scratch / "references", "--mcrt", MCRT_EXE, "--out", scratch / name};
+            script_path(),
+            std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf",
+            "--estimators",
+            "light-area",
+            "--spp",
+            "4",
+            "--quick",
+            "--reference-spp",
+            "16",
+            "--materials",
+            "lambert",
+            "--reference-cache",
+            scratch / "references",
+            "--mcrt",
+            MCRT_EXE,
+            "--out",
+            scratch / name};
         arguments.insert(arguments.end(), more.begin(), more.end());
         ProcessResult done = run_process(kPython, arguments, scratch.path(), 180.0);
         INFO(name << " stderr: " << done.err);
