@@ -134,3 +134,74 @@ TEST_CASE("experiment harness, quick mode: CSV, charts, light-area beats hemisph
     INFO("efficiency light-area " << area << ", hemisphere-cosine " << cosine);
     REQUIRE(area > cosine);
 }
+
+// --render-options reaches every render and the auto reference, through the Python module and
+// through `mcrt render` commands alike: the sun map through the Cornell box's open front adds
+// light to the reference and to the renders, the reference's cache key changes with it, and the
+// two render paths agree on every error.
+TEST_CASE("experiment harness: --render-options --env reaches the reference and the renders",
+          "[experiment][e2e]") {
+    TempDir scratch("mcrt-experiment-env");
+    require_python_modules(scratch.path());
+    ProcessResult maps = run_process(
+        kPython,
+        {std::string(MCRT_SOURCE_DIR) + "/scripts/scenes/make_sky_maps.py", scratch / "sky"},
+        scratch.path(), 120.0);
+    INFO("make_sky_maps.py: " << maps.err);
+    REQUIRE(maps.exit_code == 0);
+    std::string map = scratch / "sky/sun-sky.hdr";
+
+    auto run = [&](const std::string& name, std::vector<std::string> more) {
+        std::vector<std::string> arguments = {
+            script_path(),
+            std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf",
+            "--estimators",
+            "light-area",
+            "--spp",
+            "4",
+            "--quick",
+            "--reference-spp",
+            "16",
+            "--materials",
+            "lambert",
+            "--reference-cache",
+            scratch / "references",
+            "--mcrt",
+            MCRT_EXE,
+            "--out",
+            scratch / name};
+        arguments.insert(arguments.end(), more.begin(), more.end());
+        ProcessResult done = run_process(kPython, arguments, scratch.path(), 180.0);
+        INFO(name << " stderr: " << done.err);
+        REQUIRE_FALSE(done.timed_out);
+        REQUIRE(done.exit_code == 0);
+        auto rows = read_csv(scratch / (name + "/results.csv"));
+        REQUIRE(rows.size() == 1);
+        return std::make_pair(rows[0], read_whole_file(scratch / (name + "/reference.json")));
+    };
+    // The reference's image mean, from its provenance JSON.
+    auto reference_mean = [](const std::string& json) {
+        size_t at = json.find("\"image_mean\": ");
+        REQUIRE(at != std::string::npos);
+        return std::stod(json.substr(at + 14));
+    };
+
+    auto [plain, plain_json] = run("plain", {});
+    std::string options = "--env " + map + " --env-rotate 200";
+    auto [module, module_json] = run("env", {"--render-options", options});
+    auto [cli, cli_json] = run("env-cli", {"--render-options", options, "--cli"});
+
+    REQUIRE(plain_json.find("render_options") == std::string::npos);
+    REQUIRE(module_json.find("\"render_options\"") != std::string::npos);
+    REQUIRE(module_json.find("sun-sky.hdr") != std::string::npos);
+    // The sun through the open front: more light in the reference and in the render.
+    double plain_mean = reference_mean(plain_json), env_mean = reference_mean(module_json);
+    INFO("reference means: " << plain_mean << " without the map, " << env_mean << " with it");
+    REQUIRE(env_mean > 1.05 * plain_mean);
+    REQUIRE(std::stod(module["image_mean"]) > 1.05 * std::stod(plain["image_mean"]));
+    // The module and the commands: the same images, so the same errors against the same
+    // (cached) reference.
+    REQUIRE(reference_mean(cli_json) == env_mean);
+    REQUIRE(cli["rmse"] == module["rmse"]);
+    REQUIRE(cli["image_mean"] == module["image_mean"]);
+}

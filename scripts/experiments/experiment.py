@@ -41,7 +41,7 @@ user's estimator is charted against the built-in ones in one command.
 
 Usage: scripts/experiments/experiment.py SCENE --estimators a,b,... [--light-select power,...]
            [--samplers independent,...] (--spp 1,4,16,... | --seconds 0.5,1,2,...)
-           [--materials gltf|lambert]
+           [--materials gltf|lambert] [--render-options "--env FILE ..."]
            [--width W --height H] [--reference auto|FILE.exr] [--repeats K] --out DIR [--quick]
            [--mcrt build/mcrt] [--cli]
 """
@@ -94,6 +94,7 @@ def run_mcrt(args, scene, out_stem, estimator, light_select, sampler, seed, spp=
         options += ["--spp", "16777216", "--time-limit", repr(seconds)]
     else:
         options += ["--spp", spp]
+    options += args.render_options  # e.g. --env FILE: every render and the reference
     return mcrt_run.render(scene, out_stem, options, mcrt=args.mcrt)
 
 
@@ -124,6 +125,12 @@ def scene_hash(scene):
     return h.hexdigest()
 
 
+def option_file_hashes(options):
+    """SHA-256 of every --render-options word that names a file (an --env map), by word."""
+    return {o: hashlib.sha256(Path(o).read_bytes()).hexdigest() for o in options
+            if Path(o).is_file()}
+
+
 def reference_cache_dir():
     base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
     return Path(base) / "mcrt" / "references"
@@ -137,6 +144,9 @@ def auto_reference(args, scene, scratch):
                 "width": args.width, "height": args.height, "seeds": list(REFERENCE_SEEDS)}
     if args.max_depth != 1:  # direct lighting keeps the keys of the references it had
         settings.update(max_depth=args.max_depth, rr_depth=args.rr_depth)
+    if args.render_options:  # likewise; the files they name (a map) by their contents
+        settings.update(render_options=args.render_options,
+                        render_option_files=option_file_hashes(args.render_options))
     key = hashlib.sha256((scene_hash(scene) + json.dumps(settings, sort_keys=True))
                          .encode()).hexdigest()[:20]
     cache = Path(args.reference_cache) if args.reference_cache else reference_cache_dir()
@@ -393,6 +403,11 @@ def parse_args(argv=None):
     p.add_argument("--max-depth", type=int, default=1,
                    help="mcrt --max-depth of every render and of the auto reference (paths)")
     p.add_argument("--rr-depth", type=int, default=5, help="mcrt --rr-depth with --max-depth")
+    p.add_argument("--render-options", type=shlex.split, default=[],
+                   help="more `mcrt render` options for every render and the auto reference, "
+                        "one string, e.g. \"--env sky.hdr --env-rotate 30\" (in the "
+                        "reference's settings and cache key, reference.json and the titles); a single word starting with - as "
+                        "--render-options=--env-rotate=30")
     p.add_argument("--out", type=mcrt_run.output_directory, required=True, help="output directory")
     p.add_argument("--quick", action="store_true",
                    help="32×32 image, spp 1,4,16 unless given, 1 repeat, 512 spp reference")
@@ -452,8 +467,10 @@ def main(argv=None):
                         args.height))
     floor = ref_info.get("rmse_floor", 0.0)
     rel_floor = ref_info.get("relrmse_floor", 0.0)
-    (out / "reference.json").write_text(json.dumps(dict(ref_info, path=str(ref_path)), indent=1)
-                                        + "\n")
+    recorded = dict(ref_info, path=str(ref_path))
+    if args.render_options:  # the options of this run's renders, whatever the reference's
+        recorded["render_options"] = args.render_options
+    (out / "reference.json").write_text(json.dumps(recorded, indent=1) + "\n")
     print("experiment: reference %s: %s spp, RMSE floor %.3g from its variance layer (its two "
           "halves say %.3g)" % (ref_path, ref_info.get("spp"), floor,
                                 ref_info.get("rmse_floor_halves", float("nan"))), file=sys.stderr)
@@ -509,6 +526,9 @@ def main(argv=None):
             writer.writerow({k: ("%.6g" % v if isinstance(v, float) else v) for k, v in r.items()})
 
     title = "%s, %d×%d" % (scene.name, args.width, args.height)
+    if args.render_options:
+        title += ", " + shlex.join(Path(o).name if Path(o).is_file() else o
+                                   for o in args.render_options)
     error_chart(plt, rows, (floor, rel_floor), "seconds", "kernel seconds (seconds_render)",
                 title, out / "error_vs_time.png")
     error_chart(plt, rows, (floor, rel_floor), "spp", "samples per pixel", title,
