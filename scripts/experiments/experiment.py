@@ -254,8 +254,10 @@ def grouped(rows):
             seconds = np.mean([r["seconds"] for r in rs])
             points.append({"level": level, "spp": np.mean([r["spp"] for r in rs]),
                            "seconds": seconds, "rmse": math.sqrt(mse),
-                           "relrmse": math.sqrt(relmse), "efficiency": 1 / (mse * seconds),
-                           "rel_efficiency": 1 / (relmse * seconds)})
+                           "relrmse": math.sqrt(relmse),
+                           "efficiency": 1 / (mse * seconds) if mse * seconds > 0 else math.inf,
+                           "rel_efficiency": 1 / (relmse * seconds) if relmse * seconds > 0
+                           else math.inf})
         out[label] = sorted(points, key=lambda p: p["spp"])
     return out
 
@@ -303,18 +305,28 @@ def efficiency_chart(plt, rows, title, path):
     for ax, key, x_label in ((axes[0], "efficiency", "1 / (MSE × kernel seconds)"),
                              (axes[1], "rel_efficiency", "1 / (relMSE × kernel seconds)")):
         values = [groups[l][-1][key] for l in labels]
-        order = np.argsort(values)[::-1]
-        best = max(values)
+        finite = [v for v in values if math.isfinite(v) and v > 0]
+        if not finite:  # zero error everywhere (a black scene against its black reference)
+            ax.text(0.5, 0.5, "no error to chart: every image equals the reference",
+                    transform=ax.transAxes, ha="center", va="center", fontsize=8)
+            ax.set_xticks([])
+            ax.set_yticks([])
+            continue
+        # An exact configuration (zero error: infinite efficiency) is drawn past the best.
+        best = max(finite)
+        shown = [v if v in finite else best * 10 for v in values]
+        order = np.argsort(shown)[::-1]
         y = np.arange(len(labels))
-        ax.barh(y, [values[i] for i in order], color="C0" if key == "efficiency" else "C1")
+        ax.barh(y, [shown[i] for i in order], color="C0" if key == "efficiency" else "C1")
         ax.set_yticks(y)
         ax.set_yticklabels([labels[i] for i in order], fontsize=7)
         ax.invert_yaxis()
         ax.set_xscale("log")
         for k, i in enumerate(order):
-            ax.text(values[i], k, " %.3g (×%.2g)" % (values[i], values[i] / best), va="center",
-                    fontsize=7)
-        ax.set_xlim(min(values) / 3, best * 40)
+            text = (" %.3g (×%.2g)" % (values[i], values[i] / best) if values[i] in finite
+                    else " exact (zero error)")
+            ax.text(shown[i], k, text, va="center", fontsize=7)
+        ax.set_xlim(min(finite) / 3, best * 400)
         ax.set_xlabel(x_label + ", largest level", fontsize=8)
     fig.suptitle(title + ": efficiency (higher is better; × = relative to the best)", fontsize=9)
     fig.tight_layout()
