@@ -1,10 +1,13 @@
 /* Latitude-longitude environment maps on the device, the twins of host/scene/environment_map.h:
  * Mitsuba 3's envmap mapping for +Y up (u = atan2(x, −z)/2π, v = acos(y)/π, row 0 at the
- * zenith), nearest texels, and directions drawn by the texel CDF with their solid-angle pdf. */
+ * zenith), nearest texels, and directions drawn by the texel CDF with their solid-angle pdf.
+ * Only IEEE-754 basic operations and exact_math.cl's functions, so that every OpenCL
+ * implementation gives the same bits (the built-in atan2, acos, sin, cos and cospi differ). */
 #ifndef MCRT_ENVIRONMENT_CL
 #define MCRT_ENVIRONMENT_CL
 
 #include "discrete.cl"
+#include "exact_math.cl"
 #include "shared_types.h"
 
 typedef struct {
@@ -19,9 +22,11 @@ inline uint environment_texel(const EnvironmentMapView* env, float3 d) {
     /* The map turned by a shows at world d what it holds at R_y(−a) d. */
     float x = d.x * env->cos_rot - d.z * env->sin_rot;
     float z = d.x * env->sin_rot + d.z * env->cos_rot;
-    float u = atan2(x, -z) * (0.5f * M_1_PI_F);
+    float u = exact_atan2(x, -z) * (0.5f * M_1_PI_F);
     if (u < 0.0f) u += 1.0f;
-    float v = acos(clamp(d.y, -1.0f, 1.0f)) * M_1_PI_F;
+    /* acos(y) = atan2(√((1 − y)(1 + y)), y), y clamped to [−1, 1] */
+    float y = clamp(d.y, -1.0f, 1.0f);
+    float v = exact_atan2(sqrt((1.0f - y) * (1.0f + y)), y) * M_1_PI_F;
     uint i = min((uint)(u * (float)env->width), env->width - 1u);
     uint j = min((uint)(v * (float)env->height), env->height - 1u);
     return j * env->width + i;
@@ -31,7 +36,7 @@ inline uint environment_texel(const EnvironmentMapView* env, float3 d) {
 inline float environment_texel_solid_angle(const EnvironmentMapView* env, uint j) {
     float h = (float)env->height;
     return (2.0f * M_PI_F / (float)env->width) *
-           (cospi((float)j / h) - cospi((float)(j + 1u) / h));
+           (exact_cospi((float)j / h) - exact_cospi((float)(j + 1u) / h));
 }
 
 /* Radiance arriving from direction d (unit, world). */
@@ -51,12 +56,14 @@ typedef struct {
 inline EnvironmentSample environment_texel_direction(const EnvironmentMapView* env,
                                                      DiscreteSample ds, float2 u) {
     uint i = ds.index % env->width, j = ds.index / env->width;
-    float phi = 2.0f * M_PI_F * ((float)i + u.x) / (float)env->width;
-    float cos_top = cospi((float)j / (float)env->height);
-    float cos_bottom = cospi((float)(j + 1u) / (float)env->height);
-    float cos_theta = mix(cos_top, cos_bottom, u.y);
+    /* φ = 2π(i + u.x)/W, its sine and cosine as sinpi and cospi of φ/π */
+    float cos_phi;
+    float sin_phi = exact_sincospi(2.0f * ((float)i + u.x) / (float)env->width, &cos_phi);
+    float cos_top = exact_cospi((float)j / (float)env->height);
+    float cos_bottom = exact_cospi((float)(j + 1u) / (float)env->height);
+    float cos_theta = exact_mix(cos_top, cos_bottom, u.y);
     float sin_theta = sqrt(max(0.0f, 1.0f - cos_theta * cos_theta));
-    float xm = sin_theta * sin(phi), zm = -sin_theta * cos(phi);
+    float xm = sin_theta * sin_phi, zm = -sin_theta * cos_phi;
     EnvironmentSample s;
     s.wi = (float3)(xm * env->cos_rot + zm * env->sin_rot, cos_theta,
                     -xm * env->sin_rot + zm * env->cos_rot);

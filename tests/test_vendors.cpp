@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cl/device.h"
+#include "image/image.h"
 #include "process_support.h"
 #include "test_support.h"
 
@@ -41,6 +42,14 @@ TEST_CASE("every OpenCL implementation renders the same bytes, alone and togethe
     const std::map<std::string, int> platforms = one_device_per_platform();
     if (platforms.size() < 2)
         skip_test("one OpenCL implementation present (run under scripts/with-intel for two)");
+    // An environment map of a dim sky and a few bright texels (a sun), for the map's lookup and
+    // its texel sampling (kernels/environment.cl).
+    TempDir maps;
+    Image map(32, 16);
+    for (size_t k = 0; k < map.rgb.size(); ++k) map.rgb[k] = (k / 3) % 97 < 2 ? 500.0f : 0.4f;
+    const std::string sun = maps / "sun.exr";
+    write_exr(sun, map);
+    const std::string scenes = std::string(MCRT_SCENES);
     const std::vector<Configuration> configurations = {
         {"direct light-area", kCornell, {"--estimator", "light-area"}},
         {"glossy mis", kGlossy, {"--estimator", "mis", "--materials", "gltf"}},
@@ -54,6 +63,18 @@ TEST_CASE("every OpenCL implementation renders the same bytes, alone and togethe
         {"blended light, depth 3",
          kTextured + "blend_texture_light.gltf",
          {"--estimator", "mis", "--max-depth", "3"}},
+        {"environment map, mis depth 3",
+         scenes + "/env/sun-blocks.gltf",
+         {"--estimator", "mis", "--max-depth", "3", "--env", sun, "--env-rotate", "30"}},
+        {"environment map, light-solid-angle beside area lights",
+         kCornell,
+         {"--estimator", "light-solid-angle", "--light-select", "tree", "--env", sun}},
+        {"punctual lights, light tree, depth 2",
+         scenes + "/punctual/punctual-lights.gltf",
+         {"--estimator", "mis", "--light-select", "tree", "--max-depth", "2"}},
+        {"glass, depth 6",
+         scenes + "/glass/glass-sphere.gltf",
+         {"--estimator", "mis", "--max-depth", "6"}},
     };
     TempDir dir;
     for (const Configuration& c : configurations) {
