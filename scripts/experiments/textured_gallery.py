@@ -2,7 +2,8 @@
 """The textured glTF scenes of ../shared/scenes/textured rendered by mcrt, each beside its model's
 own reference screenshot (docs/EXPERIMENTS.md, "Textured scenes").
 
-Every scene is rendered under a uniform sky (`--sky`, default 1) by `mis` paths of up to
+Every scene is rendered under a uniform sky (`--sky`, default 1), or an environment map (`--env`,
+with `--env-scale` and `--env-rotate`), by `mis` paths of up to
 --max-depth reflections (default 4), with the glTF materials, from the view of VIEWS: the scene's
 own camera where it has one (MultiUVTest), the view of SOURCES.md for Sponza, a frontal view of
 the flat test boards (they lie in the XY plane and face +Z), and for the other models (none has
@@ -18,6 +19,7 @@ The renders stay in --out (default out/textured-gallery/), one EXR and stats JSO
 A missing --scenes folder, or a scene missing from it, is skipped with one line.
 
 Usage: scripts/experiments/textured_gallery.py [--scenes DIR] [--spp 64] [--only A,B]
+           [--env MAP.hdr [--env-scale S] [--env-rotate DEG]]
            [--figure docs/figures/textured-gallery.png] [--sponza-picture PNG] [--mcrt BIN]
 """
 
@@ -99,9 +101,13 @@ def screenshot(folder):
 
 def render_options(view, args, spp, size=None, depth=None):
     width, height = size or view.size
-    sky = view.sky if view.sky is not None else args.sky
-    return (["--width", width, "--height", height, "--spp", spp, "--sky", sky,
-             "--estimator", "mis", "--max-depth", depth or args.max_depth, "--seed", args.seed]
+    if args.env:  # the map in the sky's place, scaled as the view dims its sky
+        scale = args.env_scale * (float(view.sky) if view.sky is not None else 1.0)
+        light = ["--env", args.env, "--env-scale", scale, "--env-rotate", args.env_rotate]
+    else:
+        light = ["--sky", view.sky if view.sky is not None else args.sky]
+    return (["--width", width, "--height", height, "--spp", spp] + light +
+            ["--estimator", "mis", "--max-depth", depth or args.max_depth, "--seed", args.seed]
             + view.camera)
 
 
@@ -148,6 +154,11 @@ def main():
     p.add_argument("--spp", type=int, default=64)
     p.add_argument("--max-depth", type=int, default=4)
     p.add_argument("--sky", default="1", help="sky radiance, one value or R,G,B (default 1)")
+    p.add_argument("--env", default="",
+                   help="an environment map (.exr, .hdr) in place of the sky, as mcrt's --env "
+                   "(e.g. scripts/scenes/make_sky_maps.py's sun-sky.hdr)")
+    p.add_argument("--env-scale", type=float, default=1.0, help="with --env: mcrt's --env-scale")
+    p.add_argument("--env-rotate", type=float, default=0.0, help="with --env: mcrt's --env-rotate")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", type=mcrt_run.output_directory, default=str(ROOT / "out" / "textured-gallery"),
                    help="folder for the EXRs and stats")
