@@ -54,10 +54,32 @@ typedef struct {
 } SurfacePoint;
 
 #if defined(MCRT_TEXTURES)
+/* n turned toward ng in their plane just enough that the mirror direction of wo about it is
+ * t = min(0.9 cosθ_o, 0.01) above the surface (unchanged where it already is): Cycles'
+ * ensure_valid_specular_reflection (Blender, intern/cycles/kernel/closure/bsdf_util.h). With
+ * n' = sinφ·x + cosφ·ng, x the unit part of n across ng, the mirror direction's height is
+ * i_x sin2φ + i_z cos2φ = a cos(2φ − ψ), (i_z, i_x) = a (cosψ, sinψ), so 2φ' = ψ + β with
+ * cosβ = t/a: the root between ng and n, and n' the half vector of ng and the angle 2φ'. */
+inline float3 lift_specular_reflection(float3 n, float3 ng, float3 wo) {
+    float i_z = dot(wo, ng);
+    float t = fmin(0.9f * i_z, 0.01f);
+    if (dot(2.0f * dot(n, wo) * n - wo, ng) >= t) return n;
+    float3 x = n - dot(n, ng) * ng;
+    if (!(dot(x, x) > 0.0f)) return ng;
+    x = normalize(x);
+    float i_x = dot(wo, x);
+    float a = sqrt(i_x * i_x + i_z * i_z);
+    if (!(a > 0.0f)) return ng;
+    float cos_b = fmin(t / a, 1.0f), sin_b = sqrt(1.0f - cos_b * cos_b);
+    float cos_2phi = (i_z * cos_b - i_x * sin_b) / a, sin_2phi = (i_x * cos_b + i_z * sin_b) / a;
+    return normalize((1.0f + cos_2phi) * ng + sin_2phi * x);
+}
+
 /* The bent normal of a normal texture (glTF 2.0 "normalTexture": tangent space, +Y up, x and y
  * scaled by `scale`) about the interpolated vertex normal and MikkTSpace tangent, on the side of
  * the geometric normal ng that the ray arrived on, and turned toward the viewer where the texture
- * tilts it away (else the BSDF would be black seen from there); ng where the frame degenerates. */
+ * tilts it away (else the BSDF would be black seen from there) or, for a model with a specular
+ * lobe, past where its mirror direction leaves the surface; ng where the frame degenerates. */
 inline float3 bent_normal(const TextureView* tv, global const MaterialTextures* mt, uint lane,
                           float b1, float b2, float4 uv, const SurfacePoint* sp) {
     global const TriangleSurface* s = tv->surfaces + lane;
@@ -77,7 +99,11 @@ inline float3 bent_normal(const TextureView* tv, global const MaterialTextures* 
     float3 ns = normalize((x * mt->normal_scale) * t + (y * mt->normal_scale) * b + c.z * n);
     if (!sp->front) ns = -ns;
     if (!(dot(ns, sp->ng) > 0.0f)) return sp->ng;
-    /* Turned toward wo until wo is at least 0.01 above it. */
+    /* A specular lobe's mirror direction kept above the surface, else the rim of a bump that the
+     * texture tilts past 45° from the view reflects into the surface and renders black. */
+    if (sp->material.type != MATERIAL_LAMBERTIAN)
+        return lift_specular_reflection(ns, sp->ng, sp->wo);
+    /* Lambertian: turned toward wo until wo is at least 0.01 above it. */
     float c_o = dot(ns, sp->wo);
     if (c_o < 0.01f) ns = normalize(ns + (0.01f - c_o) * sp->wo);
     return ns;
