@@ -5,7 +5,9 @@
 //    the ratio is exact to rounding), for each wrap mode, NEAREST, KHR_texture_transform and the
 //    second texture-coordinate set;
 //  - an emissive-textured light, a light cut by MASK and a BLEND light and occluder at alpha 0.5
-//    against Lambert's formula over what remains, within the estimators' own standard errors.
+//    against Lambert's formula over what remains, within the estimators' own standard errors;
+//  - a normal texture tilted 60° from the view under the sky: a Lambertian floor gives the tilted
+//    plane's ρ (1 + cosθ)/2, and a smooth metal reflects the sky, never black.
 #include <catch2/catch.hpp>
 #include <cmath>
 
@@ -336,4 +338,78 @@ TEST_CASE("BLEND at alpha 0.5 halves a light, as a light and as an occluder",
         lit[1].Le *= 0.5;
         check_estimators(ps, exact_floor(ps, 16, 16, lit), "blended occluder");
     }
+}
+
+namespace {
+
+// A floor (y = 0, facing +Y) of one material whose 1 × 1 normal texture tilts the shading normal
+// 60° toward +X (about the vertex normal +Y and the tangent +X), under the sky light of radiance
+// 1, seen from straight above: the view is 60° from the bent normal, so its mirror direction
+// about it lies 30° below the floor.
+RenderResult tilted_floor_under_sky(const Material& material, uint32_t seed) {
+    Scene s;
+    s.materials.push_back(material);
+    add_quad(s, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, 0);
+    // (sin 60°, 0, cos 60°) as texels: (238, 128, 191).
+    const uint32_t image =
+        add_image(s, 1, 1, [](uint32_t, uint32_t) { return glm::u8vec4(238, 128, 191, 255); });
+    s.materials[0].normal_texture.image = int32_t(image);
+    set_texcoords(s, [](const glm::vec3& p) { return glm::vec2(p.x, p.z); });
+    s.normals.assign(s.positions.size(), glm::vec3(0, 1, 0));
+    s.tangents.assign(s.positions.size(), glm::vec4(1, 0, 0, 1));
+    RenderSettings settings = small_settings();
+    settings.estimator = "mis";
+    settings.sky = glm::vec3(1.0f);
+    settings.sky_light = true;
+    settings.spp = 64;
+    settings.seed = seed;
+    const Camera camera = looking_down(glm::vec3(0, 3, 0), glm::radians(40.0f));
+    GpuSceneData data = gpu_scene_for(s, camera, settings);
+    REQUIRE(data.textured);
+    return render(first_device(), data, settings);
+}
+
+}  // namespace
+
+TEST_CASE("a normal texture tilted 60° from the view: a mirror reflects the sky, not black",
+          "[textures][normal]") {
+    // Lambertian (ρ = 0.5): the sky above the floor seen by a surface tilted θ from it gives
+    // E = π L (1 + cosθ)/2 (the isotropic sky on a tilted plane), so L_o = ρ (1 + cosθ)/2, with
+    // cosθ the texel's normalised z. Directions above the bent normal but below the floor carry
+    // no light.
+    const glm::dvec3 c(238 / 255.0 * 2 - 1, 128 / 255.0 * 2 - 1, 191 / 255.0 * 2 - 1);
+    const double exact = 0.5 * (1.0 + c.z / glm::length(c)) / 2.0;
+    Material lambert;
+    lambert.albedo = glm::vec3(0.5f);
+    const RenderResult l = tilted_floor_under_sky(lambert, 11);
+    double sum = 0, variance = 0;
+    for (size_t i = 0; i < l.image.rgb.size(); ++i) {
+        sum += l.image.rgb[i];
+        variance += l.image.variance[i];
+    }
+    const double n = double(l.image.rgb.size()), mean = sum / n, se = std::sqrt(variance) / n;
+    INFO("Lambertian: mean " << mean << " +- " << se << " against " << exact);
+    CHECK(l.nan_samples == 0);
+    CHECK(std::abs(mean - exact) < 4.5 * se);
+    CHECK(se < 0.01 * exact);
+
+    // A smooth white metal (F = 1): the bent normal is turned toward the floor's until the view's
+    // mirror direction just clears the floor, and every pixel sees the sky in it. Without that
+    // turn the mirror direction points into the floor and every pixel is black.
+    Material metal;
+    metal.albedo = glm::vec3(1.0f);
+    metal.metallic = 1.0f;
+    metal.roughness = 0.0f;
+    metal.specular = 1.0f;
+    const RenderResult m = tilted_floor_under_sky(metal, 12);
+    float darkest = 1e30f;
+    double metal_sum = 0;
+    for (float v : m.image.rgb) {
+        darkest = std::min(darkest, v);
+        metal_sum += v;
+    }
+    INFO("metal: darkest pixel " << darkest << ", mean " << metal_sum / m.image.rgb.size());
+    CHECK(m.nan_samples == 0);
+    CHECK(darkest > 0.5f);
+    CHECK(metal_sum / m.image.rgb.size() > 0.9);
 }
