@@ -65,7 +65,8 @@ std::string refusal(const std::string& path) {
 
 TEST_CASE("a buffer file is read up to its byteLength, never whole", "[gltf][hostile]") {
     TempDir dir("mcrt-resources");
-    // 3 GiB, sparse: costs nothing unless read (it took 15 s and 3.1 GB before).
+    // 3 GiB, sparse: costs nothing unless read, and a loader that read it whole would take
+    // seconds and gigabytes.
     write_file(dir / "big.bin", triangle_bytes(120));
     fs::resize_file(dir / "big.bin", 3ull << 30);
     write_file(dir / "big.gltf", scene_text("big.bin"));
