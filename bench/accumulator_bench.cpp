@@ -39,9 +39,10 @@ int main(int argc, char** argv) {
             seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         }
     const Image image = accumulator.image(1024, 1024);
-    std::printf("replicates %u: %llu batches, %.3f s in submit, %.1f ns per pixel and chunk "
-                "(pixel 12345: %.9g)\n",
-                K, (unsigned long long)seq, seconds, 1e9 * seconds / (double(pixels) * chunks_total),
-                image.rgb[12345]);
+    std::printf(
+        "replicates %u: %llu batches, %.3f s in submit, %.1f ns per pixel and chunk "
+        "(pixel 12345: %.9g)\n",
+        K, (unsigned long long)seq, seconds, 1e9 * seconds / (double(pixels) * chunks_total),
+        image.rgb[12345]);
     return 0;
 }

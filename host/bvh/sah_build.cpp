@@ -31,7 +31,8 @@ V4 vmin(V4 a, V4 b) { return a < b ? a : b; }
 V4 vmax(V4 a, V4 b) { return a > b ? a : b; }
 
 // Axis-aligned box; an empty box is inverted (lo = +inf, hi = -inf) and never a point, so a union
-// with it changes nothing (merging empty boxes as points made traversal 5× slower).
+// with it changes nothing (an empty box merged as a point would stretch every box above it to
+// that point, and traversal would visit them for nothing: docs/BENCHMARKS.md "BVH build").
 struct Bounds {
     V4 lo = {kInf, kInf, kInf, 0.0f};
     V4 hi = {-kInf, -kInf, -kInf, 0.0f};

@@ -70,8 +70,8 @@ struct BuildReport {
 // build throws RuntimeError with the build log) and its binary stored for the next start: at
 // once when store_after_misses is 1, else only at the store_after_misses-th miss of the key
 // (counted in <key>.misses beside the entry). For a driver whose own cache makes a rebuild
-// cheap and asking for the binary dear (PoCL: about 1 s of code generation per variant), a
-// variant built once or twice never pays for a binary that would not be read.
+// cheap and asking for the binary dear (PoCL generates the code again: docs/BENCHMARKS.md,
+// "Start-up"), a variant built once or twice never pays for a binary that would not be read.
 // With `in_child`, the build from source runs in a child process (build_child.h), so that a
 // compiler crash costs the build (CompilerCrash), not the process.
 cl::Program build_program_cached(const cl::Context& context, const cl::Device& device,

@@ -141,11 +141,10 @@ cl::Program cached_program(const DeviceContext& device, const std::string& file,
     if (it != programs.end()) return it->second;
     // Across processes, the on-disk binary cache skips compilation on drivers without their own.
     // PoCL caches compiled kernels itself (unless POCL_KERNEL_CACHE=0), but its hit still
-    // preprocesses and hashes the source: 0.05-0.09 s, where a binary hit takes 0.015-0.025 s
-    // (start to first sample 0.13 -> 0.06-0.08 s on the Cornell box, docs/BENCHMARKS.md, issue
-    // 16). Asking PoCL for the binary costs a code generation (about 1 s per variant), so there
-    // the binary is stored at a variant's third build only: one built once or twice (most of a
-    // test suite's) never pays for it.
+    // preprocesses and hashes the source, which a binary hit skips (docs/BENCHMARKS.md, "Start-up:
+    // from the command to the first sample"). Asking PoCL for the binary costs a code generation,
+    // so there the binary is stored at a variant's third build only: one built once or twice
+    // (most of a test suite's) never pays for it.
     const char* pocl_cache = environment(kEnvPoclKernelCache);
     bool driver_caches =
         device.info.platform_name.find("Portable Computing Language") != std::string::npos &&

@@ -102,8 +102,8 @@ RenderResult render_with_workers(const std::vector<const DeviceContext*>& device
     Accumulator acc(pixels, settings.spp, settings.replicates);
     std::mutex acc_mutex;
     // Signalled by the device threads when a batch is in the image or a device retires, so that
-    // the watch loop below sees the end at once instead of at its next 20 ms tick (a 64×64
-    // render takes 20 ms in all).
+    // the watch loop below sees the end at once instead of at its next 20 ms tick, as long as a
+    // whole small render (docs/BENCHMARKS.md, "Start-up: from the command to the first sample").
     std::condition_variable progress_made;
 
     auto device_reports = [&] {

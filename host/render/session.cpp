@@ -108,7 +108,7 @@ RenderResult RenderSession::render(const std::shared_ptr<SessionScene>& scene,
     const LightSelection selection = plan.variants.light_select->id;
     // The host holds one light selection's data at a time, built only for a device that has
     // not got it yet: a sweep that returns to a selection finds it on the devices (a light
-    // tree of 10^6 lights takes 2 s to build, docs/BENCHMARKS.md).
+    // tree of many lights is slow to build: docs/BENCHMARKS.md, "Light selection").
     auto host_data = [&]() -> const GpuSceneData& {
         if (data.light_selection != selection) {
             const Activity activity("laying out the scene for the devices");

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Writes the glossy test scenes of scenes/glossy/: one quad light over a plane of one glTF
 metallic-roughness material, seen from above with the light's highlight in view (the glossy
-twins of tests/test_materials.cpp's planes).
+twins of tests/materials/test_materials.cpp's planes).
 
   white-metal-plane   metallic 1, baseColor 1, roughness 0.3 (GGX alpha 0.09): the one glossy
                       material whose BRDF Mitsuba 3 has too (roughconductor, material "none",

@@ -4,7 +4,7 @@
 Each scene is a Lambertian receiver (baseColorFactor) lit by emissive triangles (emissiveFactor ×
 KHR_materials_emissive_strength), seen by a perspective camera, with no occluder between any
 visible point and any light. So every pixel has an exact value by Lambert's formula for polygon
-lights (Arvo 1995, eq. 1), which tests/test_stress.cpp computes from the loaded file. What each
+lights (Arvo 1995, eq. 1), which tests/render/test_stress.cpp computes from the loaded file. What each
 scene stresses, and whose failure case it is: scenes/stress/README.md.
 
 Usage: scripts/scenes/make_stress_scenes.py [OUTPUT_DIR]   (default: scenes/stress of this checkout)
@@ -158,7 +158,7 @@ def floor(g, half, albedo, y=0.0):
 
 
 def looking_down(g, eye, yfov_degrees):
-    """Straight down −Y, image up = −Z (as tests/analytic_scenes.h looking_down)."""
+    """Straight down −Y, image up = −Z (as tests/support/analytic_scenes.h looking_down)."""
     g.camera(eye, (eye[0], eye[1] - 1.0, eye[2]), (0.0, 0.0, -1.0), yfov_degrees)
 
 

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Writes the small hand-made glTF files of tests/data/ used by tests/test_gltf_import.cpp.
+"""Writes the small hand-made glTF files of tests/data/ used by tests/scene/test_gltf_import.cpp.
 
 Each file is a self-contained .gltf whose one buffer is a base64 data URI. Most are broken on
 purpose (each in one way, named by the file) and must make the importer throw InputError; the

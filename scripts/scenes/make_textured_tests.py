@@ -2,7 +2,7 @@
 """Writes the analytic textured test scenes of tests/data/textured/ and what a test must see in
 them (EXPECTED.json, numbers; EXPECTED.md, the formulas), byte for byte the same on every run.
 
-Every scene is tests/analytic_scenes.h's PlaneScene geometry: the Lambertian floor y = 0,
+Every scene is tests/support/analytic_scenes.h's PlaneScene geometry: the Lambertian floor y = 0,
 [-3, 3]², baseColorFactor (0.6, 0.5, 0.4), under the quad light x ∈ [0.8, 1.3], z ∈ [-0.25, 0.25]
 at y = 1 facing down, Le (5, 4, 3) (the floor scenes also have PlaneScene's triangle light).
 Camera 0 looks straight down from (0, 3, 0) (40°, image up = −Z) and sees the floor only;
@@ -60,7 +60,7 @@ REPEAT, CLAMP, MIRROR = 10497, 33071, 33648
 WRAP_NAMES = {REPEAT: "REPEAT", CLAMP: "CLAMP_TO_EDGE", MIRROR: "MIRRORED_REPEAT"}
 
 RESOLUTION = (64, 64)   # the resolution EXPECTED.json's pixels refer to
-QUADRATURE = 8          # q × q midpoint rule per pixel, as tests/analytic_scenes.h
+QUADRATURE = 8          # q × q midpoint rule per pixel, as tests/support/analytic_scenes.h
 LABEL_MARGIN = 0.1      # a labelled pixel's footprint, grown by this many pixels, lies in one piece
 
 FLOOR_ALBEDO = (0.6, 0.5, 0.4)
@@ -656,7 +656,7 @@ WRAP_UV = (2.0, 0.5, 2.0, 0.5)               # u = 2x + 0.5: −1.5 at x = −1,
 
 
 def scenes():
-    out = [floor_scene("floor_untextured", "PlaneScene of tests/analytic_scenes.h, untextured: "
+    out = [floor_scene("floor_untextured", "PlaneScene of tests/support/analytic_scenes.h, untextured: "
                        "the twin the checker and wrap scenes are divided by")]
     out.append(floor_scene("checker", "baseColorTexture × baseColorFactor, sRGB decoded, "
                            "NEAREST, REPEAT, TEXCOORD_0", Texture("checker4x4.png"), CHECKER_UV))
@@ -837,7 +837,7 @@ def rounded(v, digits=7):
 
 FORMULAS = {
     "pixel": "pixel (i, j) = mean over a %d × %d midpoint rule of the jitter square of the radiance "
-             "along the ray of DESIGN.md's camera contract (tests/analytic_scenes.h "
+             "along the ray of DESIGN.md's camera contract (tests/support/analytic_scenes.h "
              "exact_pixel_image), at %d × %d" % (QUADRATURE, QUADRATURE, *RESOLUTION),
     "floor": "L = albedo(p)/π · Σ_pieces Le_piece · E_piece(p), albedo = baseColorFactor × "
              "sRGB-decoded texel (glTF 2.0 'Metallic-Roughness Material'), direct light only "
@@ -846,7 +846,7 @@ FORMULAS = {
                "horizon, Θ_i the angle edge i subtends at p, Γ_i the unit normal of the plane "
                "through p and edge i (Lambert 1760; Arvo 1995, 'Applications of Irradiance "
                "Tensors to the Simulation of Non-Lambertian Phenomena', SIGGRAPH, eq. 1; "
-               "tests/analytic_scenes.h lambert_irradiance)",
+               "tests/support/analytic_scenes.h lambert_irradiance)",
     "srgb": "linear = c/12.92 for c ≤ 0.04045, else ((c + 0.055)/1.055)^2.4, c = byte/255 "
             "(IEC 61966-2-1); alpha is linear, byte/255",
     "nearest": "texel column = floor(wrap_s(u')·W), row = floor(wrap_t(v')·H), row 0 the image's "

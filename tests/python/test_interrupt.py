@@ -20,8 +20,8 @@ MCRT_EXE = os.environ.get("MCRT_EXE", str(ROOT / "build" / "mcrt"))
 # not a speed requirement.
 GENEROUS_SECONDS = 5.0
 
-# An estimator whose cold build with PoCL takes many seconds (18 s on two busy cores): Ctrl-C
-# that waited for the build would come after GENEROUS_SECONDS.
+# An estimator whose cold build with PoCL takes many seconds (docs/PYTHON.md, "Threads and
+# Ctrl-C"): Ctrl-C that waited for the build would come after GENEROUS_SECONDS.
 SLOW_ESTIMATOR = (
     "float3 estimate(const SceneView* scene, const SurfacePoint* sp,\n"
     "                const SampleStream* stream, uint* rays) {\n"
@@ -125,7 +125,7 @@ def write_grid_scene(path, n):
 
 
 def test_ctrl_c_during_a_load(tmp_path):
-    # About a million triangles: 2.4 s to load here; the signal comes 0.3 s in. The child's
+    # About a million triangles, seconds to load; the signal comes 0.3 s in. The child's
     # Cornell box was loaded before, its variant is built at the render after the interrupt.
     scene = tmp_path / "grid.gltf"
     write_grid_scene(scene, 700)

@@ -27,7 +27,7 @@ PLATFORMS = first_device_per_platform()
 pytestmark = pytest.mark.skipif(
     len(PLATFORMS) < 2, reason="one OpenCL implementation present (run under scripts/with-intel)")
 
-# (scene, materials, render options): the determinism configurations of tests/test_vendors.cpp.
+# (scene, materials, render options): the determinism configurations of tests/cl/test_vendors.cpp.
 CONFIGURATIONS = {
     "direct light-area": (CORNELL, "gltf", dict(estimator="light-area")),
     "glossy mis": (GLOSSY, "gltf", dict(estimator="mis")),

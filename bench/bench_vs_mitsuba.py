@@ -42,7 +42,7 @@ check that both render the same thing.
 Writes DIR/bench_vs_mitsuba.md (the table, also printed) and DIR/bench_vs_mitsuba.json (every
 round's figures, machine, command, mcrt binary and commit, Mitsuba version).
 
-Usage: scripts/bench/bench_vs_mitsuba.py [--width 256 --height 256] [--spp 64] [--rounds 5] [--depth 8]
+Usage: bench/bench_vs_mitsuba.py [--width 256 --height 256] [--spp 64] [--rounds 5] [--depth 8]
            [--pairs mis,light-area,path] [--reference-spp 1024] [--mcrt BINARY] [--device SPEC]
            --out DIR SCENE[:sky] ...
 """
@@ -58,7 +58,7 @@ import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))  # mcrt_run, mcrt_exr
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts/tools"))  # mcrt_run, mcrt_exr
 import mcrt_run  # noqa: E402
 import mitsuba_reference as mref  # checks for numpy first (mcrt_run.require)
 import numpy as np  # noqa: E402

@@ -2,7 +2,7 @@
 """Multi-device scheduling figures: throughput with each device alone and with all together,
 each device's share of the samples against its measured speed, and a simulated slow device.
 
-Usage: scripts/bench/bench_devices.py [--scene S] [--size WxH] [--spp N] [--mcrt BINARY]
+Usage: bench/bench_devices.py [--scene S] [--size WxH] [--spp N] [--mcrt BINARY]
 Runs build/mcrt with POCL_DEVICES="pthread basic" (two PoCL devices on the same cores) and
 prints Markdown tables. MCRT_SLOW_DEVICE=D:F makes device D sleep (F-1)x its kernel time after
 each launch, i.e. behave F times slower. Only the standard library.
@@ -12,7 +12,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))  # mcrt_run, mcrt_exr
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts/tools"))  # mcrt_run, mcrt_exr
 import mcrt_run  # noqa: E402
 
 

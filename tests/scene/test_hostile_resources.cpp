@@ -65,7 +65,8 @@ std::string refusal(const std::string& path) {
 
 TEST_CASE("a buffer file is read up to its byteLength, never whole", "[gltf][hostile]") {
     TempDir dir("mcrt-resources");
-    // 3 GiB, sparse: costs nothing unless read (it took 15 s and 3.1 GB before).
+    // 3 GiB, sparse: costs nothing unless read, and a loader that read it whole would take
+    // seconds and gigabytes.
     write_file(dir / "big.bin", triangle_bytes(120));
     fs::resize_file(dir / "big.bin", 3ull << 30);
     write_file(dir / "big.gltf", scene_text("big.bin"));
@@ -258,14 +259,15 @@ TEST_CASE("experiment and bench scripts refuse an --out naming a file in argpars
     TempDir dir("mcrt-resources");
     write_file(dir / "file", std::string("x"));
     for (const char* script :
-         {"experiments/experiment.py", "experiments/light_select_table.py",
-          "experiments/path_depths.py", "experiments/pixel_maps.py", "experiments/veach_mis.py",
-          "experiments/textured_gallery.py", "experiments/textured_mitsuba.py",
-          "bench/bench_paths.py", "bench/bench_vs_mitsuba.py"}) {
+         {"scripts/experiments/experiment.py", "scripts/experiments/light_select_table.py",
+          "scripts/experiments/path_depths.py", "scripts/experiments/pixel_maps.py",
+          "scripts/experiments/veach_mis.py", "scripts/experiments/textured_gallery.py",
+          "scripts/experiments/textured_mitsuba.py", "bench/bench_paths.py",
+          "bench/bench_vs_mitsuba.py"}) {
         INFO(script);
         const std::string name = fs::path(script).filename().string();
         const ProcessResult r = run_process("/usr/bin/python3",
-                                            {std::string(MCRT_SOURCE_DIR) + "/scripts/" + script,
+                                            {std::string(MCRT_SOURCE_DIR) + "/" + script,
                                              MCRT_SCENES "/cornell/CornellBox-Original.gltf",
                                              "--estimators", "light-area", "--out", dir / "file"},
                                             dir.path(), 60);

@@ -6,7 +6,7 @@ again in a context that has rendered every variant before (programs and uploads 
 loop of `mcrt render` commands. Checks that the three give the same images, and prints the
 times and the ratios (docs/PYTHON.md).
 
-    PYTHONPATH=build/python scripts/tools/sweep_bench.py [--scene S.gltf] [--mcrt build/mcrt]
+    PYTHONPATH=build/python bench/sweep_bench.py [--scene S.gltf] [--mcrt build/mcrt]
         [--size 64] [--spp 4] [--estimators light-area,light-solid-angle,bsdf,mis]
         [--selections uniform,power,tree] [--repeats 3] [--set OPTION=VALUE ...]
 
@@ -28,10 +28,10 @@ import numpy as np
 
 import mcrt
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts/tools"))  # mcrt_exr
 from mcrt_exr import read_exr  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def parse():

@@ -8,7 +8,7 @@ second of kernel time from its stats — and scripts/tools/mitsuba_reference.py 
 (the first, which includes Dr.Jit's kernel compilation, left out). Scenes without emitters get
 `--sky 1` in both. Prints a markdown table and writes it, with the raw numbers, to --out.
 
-Usage: scripts/bench/bench_paths.py [--depth 8] [--width 128 --height 128] [--spp 64] [--variant llvm_ad_rgb]
+Usage: bench/bench_paths.py [--depth 8] [--width 128 --height 128] [--spp 64] [--variant llvm_ad_rgb]
            --out DIR SCENE[:sky] ...
 """
 
@@ -21,7 +21,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))  # mcrt_run, mcrt_exr
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts/tools"))  # mcrt_run, mcrt_exr
 import mcrt_run  # noqa: E402
 
 ROOT = mcrt_run.ROOT

@@ -2,7 +2,7 @@
 """MPI figures: one render on 1, 2 and 3 ranks of this machine (the same cores: what MPI costs),
 with the items, bytes and message overhead per work item from the stats' `ranks`.
 
-Usage: scripts/bench/bench_mpi.py [--scene S] [--size WxH] [--spp N] [--ranks 1,2,3] [--mcrt BINARY]
+Usage: bench/bench_mpi.py [--scene S] [--size WxH] [--spp N] [--ranks 1,2,3] [--mcrt BINARY]
 Prints a Markdown table (docs/BENCHMARKS.md "Several processes (MPI)"). Rank counts run through
 `mpirun --bind-to none --oversubscribe -n K`; "1 (no mpirun)" is a plain render. Only the standard library.
 """
@@ -14,7 +14,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))  # mcrt_run, mcrt_exr
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts/tools"))  # mcrt_run, mcrt_exr
 import mcrt_run  # noqa: E402
 
 

@@ -2,8 +2,8 @@
 // (host/mpi/mpi_comm.cpp, wire.cpp): rank 0 sends a 40-byte item, rank 1 answers with a result
 // of N pixels × 1 chunk; no rendering, so the time is what MPI and the polling wait cost per item.
 //
-//   mpicxx -O2 -std=c++17 -Ihost -Ikernels scripts/bench/mpi_pingpong.cpp host/mpi/mpi_comm.cpp \
-//       host/mpi/wire.cpp -o build/mpi_pingpong
+//   mpicxx -O2 -std=c++17 -Ihost -Ikernels bench/mpi_pingpong.cpp host/mpi/mpi_comm.cpp \
+//       host/mpi/wire.cpp host/common/environment.cpp -o build/mpi_pingpong
 //   mpirun --oversubscribe -n 2 build/mpi_pingpong [PIXELS=12288] [ROUNDS=200]
 #include <chrono>
 #include <cstdio>

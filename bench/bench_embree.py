@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """mcrt against Embree: the table of docs/BENCHMARKS.md, from `mcrt bench --json` runs.
 
-Usage: scripts/bench/bench_embree.py [--rounds R] [--size WxH] [--repeats K] [--scenes S ...]
+Usage: bench/bench_embree.py [--rounds R] [--size WxH] [--repeats K] [--scenes S ...]
                                [--mcrt BINARY] [-- EXTRA BENCH OPTIONS]
 Runs build/mcrt bench on each scene R times (scenes taken in turn, round by round, so that a
 change in the machine's load spreads over all of them) and prints one Markdown row per scene
@@ -16,7 +16,7 @@ import statistics
 import sys
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))  # mcrt_run, mcrt_exr
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts/tools"))  # mcrt_run, mcrt_exr
 import mcrt_run  # noqa: E402
 
 SHARED = os.path.join(os.path.dirname(mcrt_run.ROOT), "shared", "scenes")

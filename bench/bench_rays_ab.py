@@ -11,7 +11,7 @@ variant (each round's run against the first variant's of the same round, seconds
 median of its per-round ratios to Embree (measured in the same process, on the same rays), and
 its hit count beside Embree's.
 
-Usage: scripts/bench/bench_rays_ab.py --variant before=OLD/mcrt --variant after=build/mcrt [--rounds 5]
+Usage: bench/bench_rays_ab.py --variant before=OLD/mcrt --variant after=build/mcrt [--rounds 5]
            [--size 512] SCENE...
 """
 

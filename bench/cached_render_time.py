@@ -4,7 +4,7 @@ program built and its scene uploaded by an untimed first render, then 50 renders
 scene.render to the image, split into the launches (the stats' seconds_render_wall) and the
 rest (plan, device set-up, stats, numpy view). docs/PYTHON.md, "Measured".
 
-    PYTHONPATH=build/python scripts/tools/cached_render_time.py
+    PYTHONPATH=build/python bench/cached_render_time.py
 """
 
 import statistics
@@ -13,7 +13,7 @@ from pathlib import Path
 
 import mcrt
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[1]
 scene = mcrt.Context().load(str(ROOT / "scenes" / "cornell" / "CornellBox-Original.gltf"))
 scene.render(width=64, height=64, spp=16)  # the variant's first render builds its program
 total, wall = [], []

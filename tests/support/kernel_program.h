@@ -1,6 +1,6 @@
 // One test kernel file built on the first device, with what the kernel suites do with it:
 // upload a vector, allocate an output, read it back, and run an entry point with its arguments
-// (tests/test_sampling.cpp, tests/test_materials.cpp).
+// (tests/sampling/test_sampling.cpp, tests/materials/test_materials.cpp).
 #pragma once
 
 #include <algorithm>

@@ -9,9 +9,9 @@ variant without it. Leaving a stage out changes the image (that is the point) bu
 around it: the shadow ray's answer is replaced by `true`, the BSDF ray by a miss, the camera
 ray's estimate by its normal, the store by a store nobody takes, the sample hash by a cheaper one.
 The stages assume the `mis` estimator with a Lambertian scene (--materials lambert), direct
-lighting, independent sampler: what `scripts/bench/bench_vs_mitsuba.py`'s mis pair renders.
+lighting, independent sampler: what `bench/bench_vs_mitsuba.py`'s mis pair renders.
 
-Usage: scripts/bench/profile_stages.py [--rounds 5] [--width 256 --height 256 --spp 64] [--mcrt BINARY]
+Usage: bench/profile_stages.py [--rounds 5] [--width 256 --height 256 --spp 64] [--mcrt BINARY]
            [--device SPEC] SCENE...
 (--device: mcrt render's; Intel's OpenCL runtime under scripts/with-intel.)
 Needs numpy (Debian's python3-numpy; /usr/bin/python3).
@@ -24,7 +24,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))  # mcrt_run, mcrt_exr
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts/tools"))  # mcrt_run, mcrt_exr
 import bench_ab  # noqa: E402
 import mcrt_run  # noqa: E402
 

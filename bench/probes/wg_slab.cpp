@@ -1,11 +1,10 @@
-// Host of scripts/probes/wg_slab.cl: times both kernels on the first OpenCL device, alternating,
+// Host of bench/probes/wg_slab.cl: times both kernels on the first OpenCL device, alternating,
 // and prints nanoseconds per ray and node (medians of the rounds). Build and run:
-//   g++ -O2 -std=c++17 scripts/probes/wg_slab.cpp -o /tmp/wg_slab -lOpenCL
-//   /tmp/wg_slab scripts/probes/wg_slab.cl [rounds]
+//   g++ -O2 -std=c++17 bench/probes/wg_slab.cpp -o /tmp/wg_slab -lOpenCL
+//   /tmp/wg_slab bench/probes/wg_slab.cl [rounds]
 #define CL_HPP_TARGET_OPENCL_VERSION 120
 #define CL_HPP_MINIMUM_OPENCL_VERSION 120
 #include <CL/opencl.hpp>
-
 #include <algorithm>
 #include <chrono>
 #include <fstream>

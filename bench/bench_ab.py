@@ -19,7 +19,7 @@ A variant may also add options of its own (--variant-options LABEL="..."), so th
 settings compare: --variant power=build/mcrt --variant tree=build/mcrt --variant-options
 power="--light-select power" --variant-options tree="--light-select tree".
 
-Usage: scripts/bench/bench_ab.py --variant old=build-old/mcrt --variant new=build/mcrt [--rounds 5]
+Usage: bench/bench_ab.py --variant old=build-old/mcrt --variant new=build/mcrt [--rounds 5]
            [--width 256 --height 256 --spp 64] [--options "--estimator mis"]
            [--variant-options LABEL="OPTIONS"]... SCENE...
 Needs numpy (Debian's python3-numpy; /usr/bin/python3).
@@ -34,7 +34,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))  # mcrt_run, mcrt_exr
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts/tools"))  # mcrt_run, mcrt_exr
 import mcrt_run  # noqa: E402
 
 

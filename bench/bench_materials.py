@@ -3,7 +3,7 @@
 `--materials lambert` (the course's build) on the same scene, estimator and spp, in alternating
 rounds of one run (the machine is shared: only ratios measured together mean anything).
 
-Usage: scripts/bench/bench_materials.py [--scene scenes/veach-mis/veach-mis.gltf] [--size 192x108]
+Usage: bench/bench_materials.py [--scene scenes/veach-mis/veach-mis.gltf] [--size 192x108]
            [--spp 64] [--rounds 5] [--estimators light-area,bsdf,mis]
 Prints one Markdown row per estimator: median seconds of each build, their ratio and its range
 over rounds. Only the standard library.
@@ -14,7 +14,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))  # mcrt_run, mcrt_exr
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts/tools"))  # mcrt_run, mcrt_exr
 import mcrt_run  # noqa: E402
 
 

@@ -1,6 +1,6 @@
 // Pearson's χ² test with Wilson–Hilferty critical values, and the expected counts of a direction
-// grid, shared by the sampling, BSDF and glass suites (tests/test_sampling.cpp,
-// tests/test_materials.cpp, tests/test_glass.cpp).
+// grid, shared by the sampling, BSDF and glass suites (tests/sampling/test_sampling.cpp,
+// tests/materials/test_materials.cpp, tests/materials/test_glass.cpp).
 #pragma once
 
 #include <algorithm>

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Render throughput of `mcrt render` on a set of scenes, as a Markdown table.
 
-Usage: scripts/bench/bench_render.py [--spp N] [--size WxH] [--mcrt BINARY] SCENE...
+Usage: bench/bench_render.py [--spp N] [--size WxH] [--mcrt BINARY] SCENE...
 Each scene is rendered once to warm the kernel cache, then once more for the figures; the
 figures are those of the stats JSON (kernel time from OpenCL profiling events). Only the
 standard library.
@@ -12,7 +12,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))  # mcrt_run, mcrt_exr
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts/tools"))  # mcrt_run, mcrt_exr
 import mcrt_run  # noqa: E402
 
 
