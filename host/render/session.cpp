@@ -94,17 +94,21 @@ size_t RenderSession::uploaded_scenes() const {
     return uploads_.size();
 }
 
-RenderResult RenderSession::render(const std::shared_ptr<SessionScene>& scene,
-                                   const RenderPlan& plan, const ProgressSink& progress,
-                                   const RenderControl& control, const WarningSink& warn,
-                                   const RemoteWorkers& remote) {
-    std::lock_guard<std::mutex> lock(mutex_);
+RenderSession::SceneUploads& RenderSession::uploads_of(
+    const std::shared_ptr<SessionScene>& scene) {
     // The buffers of scenes nobody holds any more go before anything is uploaded.
     for (auto it = uploads_.begin(); it != uploads_.end();)
         it = it->second.scene.expired() ? uploads_.erase(it) : std::next(it);
     SceneUploads& uploads = uploads_[scene->id];
     uploads.scene = scene;
-    GpuSceneData& data = scene->prepared.gpu;
+    return uploads;
+}
+
+std::unique_ptr<DeviceWorker> RenderSession::make_worker(SceneUploads& uploads,
+                                                         SessionScene& scene,
+                                                         const RenderPlan& plan,
+                                                         const DeviceContext& device) {
+    GpuSceneData& data = scene.prepared.gpu;
     const LightSelection selection = plan.variants.light_select->id;
     // The host holds one light selection's data at a time, built only for a device that has
     // not got it yet: a sweep that returns to a selection finds it on the devices (a light
@@ -116,29 +120,54 @@ RenderResult RenderSession::render(const std::shared_ptr<SessionScene>& scene,
         }
         return data;
     };
+    DeviceUpload& upload = uploads.devices[device.info.index];
+    if (!upload.buffers) {
+        const GpuSceneData& selected = host_data();
+        const Activity activity("uploading the scene");
+        upload.buffers = std::make_unique<GpuSceneBuffers>(device, selected);
+        upload.selections[selection] = {upload.buffers->light_selection,
+                                        upload.buffers->light_tree_nodes};
+    }
+    auto kept = upload.selections.find(selection);
+    if (kept == upload.selections.end()) {
+        DeviceUpload::Selection added;
+        added.buffer = upload_light_selection(device, host_data(), &added.tree_nodes);
+        kept = upload.selections.emplace(selection, added).first;
+    }
+    write_camera(device, *upload.buffers, data.camera);
+    GpuSceneBuffers buffers = *upload.buffers;  // handles, sharing the device's buffers
+    buffers.light_selection = kept->second.buffer;
+    buffers.light_tree_nodes = kept->second.tree_nodes;
+    return std::make_unique<DeviceWorker>(device, buffers, plan);
+}
 
-    const WorkerFactory make_worker = [&](const DeviceContext& device) {
-        DeviceUpload& upload = uploads.devices[device.info.index];
-        if (!upload.buffers) {
-            const GpuSceneData& selected = host_data();
-            const Activity activity("uploading the scene");
-            upload.buffers = std::make_unique<GpuSceneBuffers>(device, selected);
-            upload.selections[selection] = {upload.buffers->light_selection,
-                                            upload.buffers->light_tree_nodes};
-        }
-        auto kept = upload.selections.find(selection);
-        if (kept == upload.selections.end()) {
-            DeviceUpload::Selection added;
-            added.buffer = upload_light_selection(device, host_data(), &added.tree_nodes);
-            kept = upload.selections.emplace(selection, added).first;
-        }
-        write_camera(device, *upload.buffers, data.camera);
-        GpuSceneBuffers buffers = *upload.buffers;  // handles, sharing the device's buffers
-        buffers.light_selection = kept->second.buffer;
-        buffers.light_tree_nodes = kept->second.tree_nodes;
-        return std::make_unique<DeviceWorker>(device, buffers, plan);
+RenderResult RenderSession::render(const std::shared_ptr<SessionScene>& scene,
+                                   const RenderPlan& plan, const ProgressSink& progress,
+                                   const RenderControl& control, const WarningSink& warn,
+                                   const RemoteWorkers& remote) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    SceneUploads& uploads = uploads_of(scene);
+    const WorkerFactory make = [&](const DeviceContext& device) {
+        return make_worker(uploads, *scene, plan, device);
     };
-    return render_with_workers(device_list_, make_worker, plan, progress, control, warn, remote);
+    return render_with_workers(device_list_, make, plan, progress, control, warn, remote);
+}
+
+void RenderSession::serve(const std::shared_ptr<SessionScene>& scene, const RenderPlan& plan,
+                          const Serve& serve, const WarningSink& warn) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    SceneUploads& uploads = uploads_of(scene);
+    std::vector<std::unique_ptr<DeviceWorker>> workers;
+    for (const DeviceContext* d : device_list_) {
+        try {
+            workers.push_back(make_worker(uploads, *scene, plan, *d));
+        } catch (const std::exception& e) {
+            if (warn)
+                warn("skipping device " + std::to_string(d->info.index) + " ('" + d->info.name +
+                     "'): " + e.what());
+        }
+    }
+    serve(workers);
 }
 
 }  // namespace mcrt

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "cl/device.h"
+#include "render/device_worker.h"
 #include "render/plan.h"
 #include "render/renderer.h"
 
@@ -77,6 +79,14 @@ class RenderSession {
                         const ProgressSink& progress = {}, const RenderControl& control = {},
                         const WarningSink& warn = {}, const RemoteWorkers& remote = {});
 
+    // The workers of a render that another process drives (an MPI rank serving rank 0's work
+    // items, host/mpi/job.h): set up on the scene's buffers kept on each device as render() sets
+    // up its own, one per device; a device that cannot render is skipped with a warning through
+    // `warn`. `serve` runs with them while the session renders nothing else.
+    using Serve = std::function<void(std::vector<std::unique_ptr<DeviceWorker>>& workers)>;
+    void serve(const std::shared_ptr<SessionScene>& scene, const RenderPlan& plan,
+               const Serve& serve, const WarningSink& warn = {});
+
     // Scenes whose buffers are on the devices now (tests: a released scene's are freed).
     size_t uploaded_scenes() const;
 
@@ -95,6 +105,13 @@ class RenderSession {
         std::weak_ptr<SessionScene> scene;
         std::map<int, DeviceUpload> devices;  // by device index
     };
+
+    // The scene's uploads, those of scenes nobody holds any more released first. Holds mutex_.
+    SceneUploads& uploads_of(const std::shared_ptr<SessionScene>& scene);
+    // A worker on `device` for the plan, on the scene's buffers there (uploaded at the first).
+    // Holds mutex_.
+    std::unique_ptr<DeviceWorker> make_worker(SceneUploads& uploads, SessionScene& scene,
+                                              const RenderPlan& plan, const DeviceContext& device);
 
     std::vector<std::shared_ptr<DeviceContext>> contexts_;
     std::vector<const DeviceContext*> device_list_;
