@@ -27,6 +27,7 @@
 #include "cli/usage_errors.h"
 #include "cli/validators.h"
 #include "common/error.h"
+#include "common/test_hooks.h"
 #include "image/image.h"
 #include "interruptible.h"
 #include "render/estimator_file.h"
@@ -322,11 +323,17 @@ PYBIND11_MODULE(_mcrt, m) {
     py::register_exception_translator(&translate);
 
     m.def("devices", [] {
-        std::vector<std::string> warnings;
-        std::vector<DeviceInfo> devices =
-            enumerate_devices([&](const std::string& w) { warnings.push_back(w); });
+        // OpenCL's start-up (loading every platform's driver) runs on a thread of its own, as a
+        // render does (run_interruptible): Ctrl-C raises at once, other Python threads run.
+        auto devices = std::make_shared<std::vector<DeviceInfo>>();
+        run_interruptible(
+            [devices](Job&) {
+                test_pause("start-up");
+                *devices = enumerate_devices([](const std::string&) {});
+            },
+            py::none());
         py::list list;
-        for (const DeviceInfo& d : devices) list.append(device_dict(d));
+        for (const DeviceInfo& d : *devices) list.append(device_dict(d));
         return list;
     });
     m.def(
@@ -417,16 +424,23 @@ PYBIND11_MODULE(_mcrt, m) {
     py::class_<ContextState, std::shared_ptr<ContextState>>(m, "_Context")
         .def(py::init([](const std::vector<std::string>& devices) {
                  auto state = std::make_shared<ContextState>();
-                 translating(
-                     [&] {
-                         WarningSink warn = [&](const std::string& w) {
-                             state->warnings.push_back(w);
-                         };
-                         state->session =
-                             std::make_unique<RenderSession>(select_devices(devices, warn), warn);
-                         return 0;
+                 // The devices' start-up (drivers, contexts, queues) on a thread of its own, as
+                 // devices() does; abandoned at Ctrl-C, it ends in the background.
+                 run_interruptible(
+                     [state, devices](Job&) {
+                         translating(
+                             [&] {
+                                 WarningSink warn = [&](const std::string& w) {
+                                     state->warnings.push_back(w);
+                                 };
+                                 test_pause("start-up");
+                                 state->session = std::make_unique<RenderSession>(
+                                     select_devices(devices, warn), warn);
+                                 return 0;
+                             },
+                             InputKind::Setting);
                      },
-                     InputKind::Setting);
+                     py::none());
                  return state;
              }),
              py::arg("devices"))
