@@ -233,7 +233,8 @@ PyResult render_scene(PyScene& self, const std::vector<std::string>& args,
                     if (!context->session)
                         throw PyDeviceError("the context of this scene is closed");
                     std::lock_guard<std::mutex> scene_lock(scene->use);
-                    const RenderPlan plan = plan_session_render(*scene, request, warn);
+                    const RenderPlan plan = plan_session_render(
+                        *scene, request, warn, {}, &context->session->environments());
                     check_host_memory(
                         "a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " render",
                         render_host_bytes(o.width, o.height, plan.settings.replicates));
@@ -446,6 +447,11 @@ PYBIND11_MODULE(_mcrt, m) {
              py::arg("devices"))
         .def_property_readonly("warnings", [](const ContextState& c) { return c.warnings; })
         .def_property_readonly("closed", [](ContextState& c) { return c.closed.load(); })
+        .def_property_readonly("_environment_reads",
+                               [](ContextState& c) {
+                                   std::unique_lock<std::mutex> lock = lock_without_gil(c.mutex);
+                                   return c.session ? c.session->environments().reads() : 0;
+                               })
         .def_property_readonly("devices",
                                [](ContextState& c) {
                                    std::unique_lock<std::mutex> lock = lock_without_gil(c.mutex);

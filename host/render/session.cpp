@@ -1,5 +1,8 @@
 #include "render/session.h"
 
+#include <sys/stat.h>
+
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 
@@ -48,7 +51,8 @@ std::shared_ptr<SessionScene> load_session_scene(const std::string& path,
 }
 
 RenderPlan plan_session_render(SessionScene& scene, const RenderRequest& request,
-                               const WarningSink& warn, const SceneSource& source) {
+                               const WarningSink& warn, const SceneSource& source,
+                               EnvironmentCache* environments) {
     RenderPlan plan = check_render_settings(request.settings, request.sky);
     if (plan.settings.materials != scene.materials)
         throw SettingError("materials", plan.settings.materials + ": the scene was loaded with " +
@@ -60,8 +64,64 @@ RenderPlan plan_session_render(SessionScene& scene, const RenderRequest& request
     if (warn && prepared.scene.triangle_count() == 0)
         warn(scene.path + ": the scene has no triangles");
     warn_unseen_lights(scene.path, plan, prepared.gpu, warn);
-    plan_environment(plan, prepared.gpu, source);
+    if (environments && !s.env.empty() && !source.bundle && !source.record) {
+        // plan_environment with the session's map.
+        {
+            const Activity activity("loading the environment map");
+            plan.environment = environments->load(s.env, s.env_scale, s.env_rotate);
+        }
+        plan.environment_steps =
+            s.sky_light ? environment_pmf_steps(*plan.environment, prepared.gpu,
+                                                plan.variants.light_select->id)
+                        : 0;
+    } else {
+        plan_environment(plan, prepared.gpu, source);
+    }
     return finish_render_plan(std::move(plan), prepared.gpu);
+}
+
+std::optional<EnvironmentCache::FileIdentity> EnvironmentCache::identify(
+    const std::string& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
+    FileIdentity id;
+    id.device = uint64_t(st.st_dev);
+    id.inode = uint64_t(st.st_ino);
+    id.size = uint64_t(st.st_size);
+    id.mtime_ns = int64_t(st.st_mtim.tv_sec) * 1000000000 + int64_t(st.st_mtim.tv_nsec);
+    return id;
+}
+
+std::shared_ptr<const EnvironmentLight> EnvironmentCache::load(const std::string& path,
+                                                               float scale, float rotate_deg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const std::optional<FileIdentity> before = identify(path);
+    auto kept = maps_.find(path);
+    if (before && kept != maps_.end() && kept->second.file == *before &&
+        kept->second.scale == scale && kept->second.rotate_deg == rotate_deg) {
+        kept->second.last_use = ++uses_;
+        return kept->second.light;
+    }
+    ++reads_;
+    std::shared_ptr<const EnvironmentLight> light =
+        load_environment_light(path, scale, rotate_deg, nullptr, nullptr);
+    // Kept only when the file did not change while it was read.
+    const std::optional<FileIdentity> after = identify(path);
+    if (before && after && *before == *after) {
+        if (kept == maps_.end() && maps_.size() >= kMaxMaps)
+            maps_.erase(std::min_element(maps_.begin(), maps_.end(), [](auto& a, auto& b) {
+                return a.second.last_use < b.second.last_use;
+            }));
+        maps_[path] = Entry{*after, scale, rotate_deg, light, ++uses_};
+    } else if (kept != maps_.end()) {
+        maps_.erase(kept);
+    }
+    return light;
+}
+
+uint64_t EnvironmentCache::reads() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return reads_;
 }
 
 std::shared_ptr<DeviceContext> process_device_context(const DeviceInfo& device) {
