@@ -346,7 +346,15 @@ int serve_render(const std::function<RenderRequest()>& make_request,
         const std::vector<DeviceInfo> devices = select_devices(device_names, warn);
         if (devices.size() > size_t(mpi::kMaxSlots))
             throw RuntimeError("more than " + std::to_string(mpi::kMaxSlots) + " devices");
-        session = std::make_unique<RenderSession>(devices, warn);
+        try {
+            session = std::make_unique<RenderSession>(devices, warn);
+        } catch (const RuntimeError& e) {
+            // The session warned of every device it skipped but the last, whose error it threw.
+            if (devices.empty()) throw;
+            const DeviceInfo& d = devices.back();
+            throw RuntimeError("skipping device " + std::to_string(d.index) + " ('" + d.name +
+                               "'): " + e.what());
+        }
     } catch (const std::exception& e) {
         warn(e.what());
         session.reset();
