@@ -145,13 +145,18 @@ PAUSE_SECONDS = 300
 CHILD_TIMEOUT = 120
 
 STARTUP_CHILD = r"""
-import os, sys, threading
+import os, sys, threading, time
 import mcrt
-call, flag = sys.argv[1:3]
+call, flag, stderr_file = sys.argv[1:4]
 def other():
-    print("thread ran", flush=True)
+    # Runs once the start-up is in its pause (its line is in this process's stderr file).
+    while "paused at start-up" not in open(stderr_file).read():
+        time.sleep(0.01)
+    sys.stdout.write("thread ran\n")
+    sys.stdout.flush()
     open(flag, "w").close()  # ends the start-up's pause
-threading.Thread(target=other).start()
+if stderr_file:
+    threading.Thread(target=other).start()
 print("calling", flush=True)
 try:
     mcrt.Context() if call == "Context" else mcrt.devices()
@@ -162,27 +167,30 @@ except KeyboardInterrupt:
 """
 
 
-def startup_child(tmp_path, call, flag):
+def startup_child(tmp_path, call, flag, stderr_file=None):
+    """The child, its stderr in `stderr_file` (its other thread waits for the pause's line there)
+    or, without one, a pipe."""
     env = dict(os.environ, MCRT_TEST_PAUSE="start-up", MCRT_TEST_PAUSE_SECONDS=str(PAUSE_SECONDS),
                MCRT_TEST_PAUSE_UNTIL=str(flag), PYTHONUNBUFFERED="1")
-    return subprocess.Popen([sys.executable, "-c", STARTUP_CHILD, call, str(flag)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    return subprocess.Popen(
+        [sys.executable, "-c", STARTUP_CHILD, call, str(flag), str(stderr_file or "")],
+        stdout=subprocess.PIPE, text=True, env=env,
+        stderr=open(stderr_file, "w") if stderr_file else subprocess.PIPE)
 
 
 @pytest.mark.parametrize("call", ["Context", "devices"])
 def test_other_threads_run_during_opencl_start_up(tmp_path, call):
-    # The other thread ends the pause: the call returns only once that thread has run.
-    child = startup_child(tmp_path, call, tmp_path / "flag")
+    # The other thread, run during the pause, ends it: the call returns only once it has run.
+    stderr_file = tmp_path / "stderr"
+    child = startup_child(tmp_path, call, tmp_path / "flag", stderr_file)
     try:
-        stdout, stderr = child.communicate(timeout=CHILD_TIMEOUT)
+        stdout, _ = child.communicate(timeout=CHILD_TIMEOUT)
     finally:
         if child.poll() is None:
             child.kill()
             child.wait()
-    assert child.returncode == 0, stderr
-    assert "mcrt: test: paused at start-up" in stderr
-    lines = stdout.split()
-    assert lines.index("ran") < lines.index("returned"), stdout
+    assert child.returncode == 0, stderr_file.read_text()
+    assert stdout.split("\n")[:3] == ["calling", "thread ran", "returned"], stdout
 
 
 @pytest.mark.parametrize("call", ["Context", "devices"])
