@@ -27,6 +27,7 @@
 #include "cli/usage_errors.h"
 #include "cli/validators.h"
 #include "common/error.h"
+#include "common/test_hooks.h"
 #include "image/image.h"
 #include "interruptible.h"
 #include "render/estimator_file.h"
@@ -232,7 +233,8 @@ PyResult render_scene(PyScene& self, const std::vector<std::string>& args,
                     if (!context->session)
                         throw PyDeviceError("the context of this scene is closed");
                     std::lock_guard<std::mutex> scene_lock(scene->use);
-                    const RenderPlan plan = plan_session_render(*scene, request, warn);
+                    const RenderPlan plan = plan_session_render(
+                        *scene, request, warn, {}, &context->session->environments());
                     check_host_memory(
                         "a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " render",
                         render_host_bytes(o.width, o.height, plan.settings.replicates));
@@ -322,11 +324,17 @@ PYBIND11_MODULE(_mcrt, m) {
     py::register_exception_translator(&translate);
 
     m.def("devices", [] {
-        std::vector<std::string> warnings;
-        std::vector<DeviceInfo> devices =
-            enumerate_devices([&](const std::string& w) { warnings.push_back(w); });
+        // OpenCL's start-up (loading every platform's driver) runs on a thread of its own, as a
+        // render does (run_interruptible): Ctrl-C raises at once, other Python threads run.
+        auto devices = std::make_shared<std::vector<DeviceInfo>>();
+        run_interruptible(
+            [devices](Job&) {
+                test_pause("start-up");
+                *devices = enumerate_devices([](const std::string&) {});
+            },
+            py::none());
         py::list list;
-        for (const DeviceInfo& d : devices) list.append(device_dict(d));
+        for (const DeviceInfo& d : *devices) list.append(device_dict(d));
         return list;
     });
     m.def(
@@ -417,21 +425,33 @@ PYBIND11_MODULE(_mcrt, m) {
     py::class_<ContextState, std::shared_ptr<ContextState>>(m, "_Context")
         .def(py::init([](const std::vector<std::string>& devices) {
                  auto state = std::make_shared<ContextState>();
-                 translating(
-                     [&] {
-                         WarningSink warn = [&](const std::string& w) {
-                             state->warnings.push_back(w);
-                         };
-                         state->session =
-                             std::make_unique<RenderSession>(select_devices(devices, warn), warn);
-                         return 0;
+                 // The devices' start-up (drivers, contexts, queues) on a thread of its own, as
+                 // devices() does; abandoned at Ctrl-C, it ends in the background.
+                 run_interruptible(
+                     [state, devices](Job&) {
+                         translating(
+                             [&] {
+                                 WarningSink warn = [&](const std::string& w) {
+                                     state->warnings.push_back(w);
+                                 };
+                                 test_pause("start-up");
+                                 state->session = std::make_unique<RenderSession>(
+                                     select_devices(devices, warn), warn);
+                                 return 0;
+                             },
+                             InputKind::Setting);
                      },
-                     InputKind::Setting);
+                     py::none());
                  return state;
              }),
              py::arg("devices"))
         .def_property_readonly("warnings", [](const ContextState& c) { return c.warnings; })
         .def_property_readonly("closed", [](ContextState& c) { return c.closed.load(); })
+        .def_property_readonly("_environment_reads",
+                               [](ContextState& c) {
+                                   std::unique_lock<std::mutex> lock = lock_without_gil(c.mutex);
+                                   return c.session ? c.session->environments().reads() : 0;
+                               })
         .def_property_readonly("devices",
                                [](ContextState& c) {
                                    std::unique_lock<std::mutex> lock = lock_without_gil(c.mutex);

@@ -12,7 +12,8 @@ namespace mcrt {
 // MCRT_TEST_PAUSE_UNTIL exists. Otherwise nothing. Points: "before-write" (the outputs'
 // temporaries exist, nothing is written yet), "write" (all written, before the commit),
 // "commit" (inside the commit, after the first rename), "commit-wait" (another process holds
-// an output directory's lock; this one waits for it next), "exit" (after the command).
+// an output directory's lock; this one waits for it next), "exit" (after the command),
+// "start-up" (the Python module's mcrt.Context() and mcrt.devices(), before OpenCL starts).
 void test_pause(const char* point);
 
 // True when MCRT_TEST_NO_TMPFILE is set: outputs take the named-temporary path that file systems

@@ -27,6 +27,7 @@
 #include "mpi/remote_worker.h"
 #include "mpi/wire.h"
 #include "render/device_worker.h"
+#include "render/session.h"
 #include "render/variants.h"
 
 namespace mcrt {
@@ -324,9 +325,11 @@ int serve_render(const std::function<RenderRequest()>& make_request,
     wire::Hello hello;
     hello.host = mpi::host_name();
     auto warn = [&](const std::string& w) { hello.warnings.push_back(w); };
-    PlannedRender render;
-    std::vector<std::unique_ptr<DeviceContext>> contexts;
-    std::vector<std::unique_ptr<DeviceWorker>> workers;
+    // The rank renders as rank 0 does: its scene loaded into a session (render/session.h) that
+    // owns the devices, their programs and the scene's buffers on them.
+    std::unique_ptr<RenderSession> session;
+    std::shared_ptr<SessionScene> scene;
+    RenderPlan plan;
     try {
         FileBundle files;
         RenderRequest r = make_request();  // rank 0 made the same one: it said go
@@ -334,41 +337,49 @@ int serve_render(const std::function<RenderRequest()>& make_request,
         bytes = {};
         SceneSource source;
         source.bundle = &files;
-        render = plan_render(r, source, {});  // rank 0 printed the scene's warnings
+        // Rank 0 printed the scene's warnings.
+        const RenderPlan checked = check_render_settings(r.settings, r.sky);
+        scene = load_session_scene(r.scene, checked.settings.materials,
+                                   checked.variants.light_select->id, source, {});
+        plan = plan_session_render(*scene, r, {}, source);
         files.clear();
         const std::vector<DeviceInfo> devices = select_devices(device_names, warn);
         if (devices.size() > size_t(mpi::kMaxSlots))
             throw RuntimeError("more than " + std::to_string(mpi::kMaxSlots) + " devices");
-        for (const DeviceInfo& d : devices) {
-            try {
-                contexts.push_back(std::make_unique<DeviceContext>(d));
-                workers.push_back(std::make_unique<DeviceWorker>(*contexts.back(), render.scene.gpu,
-                                                                 render.plan));
-            } catch (const std::exception& e) {
-                warn("skipping device " + std::to_string(d.index) + " ('" + d.name +
-                     "'): " + e.what());
-            }
+        try {
+            session = std::make_unique<RenderSession>(devices, warn);
+        } catch (const RuntimeError& e) {
+            // The session warned of every device it skipped but the last, whose error it threw.
+            if (devices.empty()) throw;
+            const DeviceInfo& d = devices.back();
+            throw RuntimeError("skipping device " + std::to_string(d.index) + " ('" + d.name +
+                               "'): " + e.what());
         }
     } catch (const std::exception& e) {
         warn(e.what());
-        workers.clear();
+        session.reset();
     }
-    for (const auto& w : workers) {
-        hello.devices.emplace_back(w->report.index, w->report.name);
-    }
-    mpi::send_bytes(wire::encode_hello(hello), 0, mpi::kHelloTag);
 
-    std::vector<std::thread> threads;
-    for (size_t slot = 0; slot < workers.size(); ++slot)
-        threads.emplace_back([&, slot] {
-            try {
-                serve_device(*workers[slot], int(slot));
-            } catch (const std::exception& e) {  // a message rank 0 did not send: a bug
-                std::fprintf(stderr, "mcrt: error: rank %d: %s\n", g_rank, e.what());
-                MPI_Abort(MPI_COMM_WORLD, 1);
-            }
-        });
-    for (std::thread& t : threads) t.join();
+    auto serve_devices = [&](std::vector<std::unique_ptr<DeviceWorker>>& workers) {
+        for (const auto& w : workers) hello.devices.emplace_back(w->report.index, w->report.name);
+        mpi::send_bytes(wire::encode_hello(hello), 0, mpi::kHelloTag);
+        std::vector<std::thread> threads;
+        for (size_t slot = 0; slot < workers.size(); ++slot)
+            threads.emplace_back([&, slot] {
+                try {
+                    serve_device(*workers[slot], int(slot));
+                } catch (const std::exception& e) {  // a message rank 0 did not send: a bug
+                    std::fprintf(stderr, "mcrt: error: rank %d: %s\n", g_rank, e.what());
+                    MPI_Abort(MPI_COMM_WORLD, 1);
+                }
+            });
+        for (std::thread& t : threads) t.join();
+    };
+    std::vector<std::unique_ptr<DeviceWorker>> none;
+    if (session)
+        session->serve(scene, plan, serve_devices, warn);
+    else
+        serve_devices(none);
     return int(mpi::broadcast_u64(0, 0));
 }
 

@@ -1,5 +1,8 @@
 #include "render/session.h"
 
+#include <sys/stat.h>
+
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 
@@ -48,7 +51,8 @@ std::shared_ptr<SessionScene> load_session_scene(const std::string& path,
 }
 
 RenderPlan plan_session_render(SessionScene& scene, const RenderRequest& request,
-                               const WarningSink& warn, const SceneSource& source) {
+                               const WarningSink& warn, const SceneSource& source,
+                               EnvironmentCache* environments) {
     RenderPlan plan = check_render_settings(request.settings, request.sky);
     if (plan.settings.materials != scene.materials)
         throw SettingError("materials", plan.settings.materials + ": the scene was loaded with " +
@@ -60,8 +64,64 @@ RenderPlan plan_session_render(SessionScene& scene, const RenderRequest& request
     if (warn && prepared.scene.triangle_count() == 0)
         warn(scene.path + ": the scene has no triangles");
     warn_unseen_lights(scene.path, plan, prepared.gpu, warn);
-    plan_environment(plan, prepared.gpu, source);
+    if (environments && !s.env.empty() && !source.bundle && !source.record) {
+        // plan_environment with the session's map.
+        {
+            const Activity activity("loading the environment map");
+            plan.environment = environments->load(s.env, s.env_scale, s.env_rotate);
+        }
+        plan.environment_steps =
+            s.sky_light ? environment_pmf_steps(*plan.environment, prepared.gpu,
+                                                plan.variants.light_select->id)
+                        : 0;
+    } else {
+        plan_environment(plan, prepared.gpu, source);
+    }
     return finish_render_plan(std::move(plan), prepared.gpu);
+}
+
+std::optional<EnvironmentCache::FileIdentity> EnvironmentCache::identify(
+    const std::string& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
+    FileIdentity id;
+    id.device = uint64_t(st.st_dev);
+    id.inode = uint64_t(st.st_ino);
+    id.size = uint64_t(st.st_size);
+    id.mtime_ns = int64_t(st.st_mtim.tv_sec) * 1000000000 + int64_t(st.st_mtim.tv_nsec);
+    return id;
+}
+
+std::shared_ptr<const EnvironmentLight> EnvironmentCache::load(const std::string& path,
+                                                               float scale, float rotate_deg) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const std::optional<FileIdentity> before = identify(path);
+    auto kept = maps_.find(path);
+    if (before && kept != maps_.end() && kept->second.file == *before &&
+        kept->second.scale == scale && kept->second.rotate_deg == rotate_deg) {
+        kept->second.last_use = ++uses_;
+        return kept->second.light;
+    }
+    ++reads_;
+    std::shared_ptr<const EnvironmentLight> light =
+        load_environment_light(path, scale, rotate_deg, nullptr, nullptr);
+    // Kept only when the file did not change while it was read.
+    const std::optional<FileIdentity> after = identify(path);
+    if (before && after && *before == *after) {
+        if (kept == maps_.end() && maps_.size() >= kMaxMaps)
+            maps_.erase(std::min_element(maps_.begin(), maps_.end(), [](auto& a, auto& b) {
+                return a.second.last_use < b.second.last_use;
+            }));
+        maps_[path] = Entry{*after, scale, rotate_deg, light, ++uses_};
+    } else if (kept != maps_.end()) {
+        maps_.erase(kept);
+    }
+    return light;
+}
+
+uint64_t EnvironmentCache::reads() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return reads_;
 }
 
 std::shared_ptr<DeviceContext> process_device_context(const DeviceInfo& device) {
@@ -94,17 +154,21 @@ size_t RenderSession::uploaded_scenes() const {
     return uploads_.size();
 }
 
-RenderResult RenderSession::render(const std::shared_ptr<SessionScene>& scene,
-                                   const RenderPlan& plan, const ProgressSink& progress,
-                                   const RenderControl& control, const WarningSink& warn,
-                                   const RemoteWorkers& remote) {
-    std::lock_guard<std::mutex> lock(mutex_);
+RenderSession::SceneUploads& RenderSession::uploads_of(
+    const std::shared_ptr<SessionScene>& scene) {
     // The buffers of scenes nobody holds any more go before anything is uploaded.
     for (auto it = uploads_.begin(); it != uploads_.end();)
         it = it->second.scene.expired() ? uploads_.erase(it) : std::next(it);
     SceneUploads& uploads = uploads_[scene->id];
     uploads.scene = scene;
-    GpuSceneData& data = scene->prepared.gpu;
+    return uploads;
+}
+
+std::unique_ptr<DeviceWorker> RenderSession::make_worker(SceneUploads& uploads,
+                                                         SessionScene& scene,
+                                                         const RenderPlan& plan,
+                                                         const DeviceContext& device) {
+    GpuSceneData& data = scene.prepared.gpu;
     const LightSelection selection = plan.variants.light_select->id;
     // The host holds one light selection's data at a time, built only for a device that has
     // not got it yet: a sweep that returns to a selection finds it on the devices (a light
@@ -116,29 +180,54 @@ RenderResult RenderSession::render(const std::shared_ptr<SessionScene>& scene,
         }
         return data;
     };
+    DeviceUpload& upload = uploads.devices[device.info.index];
+    if (!upload.buffers) {
+        const GpuSceneData& selected = host_data();
+        const Activity activity("uploading the scene");
+        upload.buffers = std::make_unique<GpuSceneBuffers>(device, selected);
+        upload.selections[selection] = {upload.buffers->light_selection,
+                                        upload.buffers->light_tree_nodes};
+    }
+    auto kept = upload.selections.find(selection);
+    if (kept == upload.selections.end()) {
+        DeviceUpload::Selection added;
+        added.buffer = upload_light_selection(device, host_data(), &added.tree_nodes);
+        kept = upload.selections.emplace(selection, added).first;
+    }
+    write_camera(device, *upload.buffers, data.camera);
+    GpuSceneBuffers buffers = *upload.buffers;  // handles, sharing the device's buffers
+    buffers.light_selection = kept->second.buffer;
+    buffers.light_tree_nodes = kept->second.tree_nodes;
+    return std::make_unique<DeviceWorker>(device, buffers, plan);
+}
 
-    const WorkerFactory make_worker = [&](const DeviceContext& device) {
-        DeviceUpload& upload = uploads.devices[device.info.index];
-        if (!upload.buffers) {
-            const GpuSceneData& selected = host_data();
-            const Activity activity("uploading the scene");
-            upload.buffers = std::make_unique<GpuSceneBuffers>(device, selected);
-            upload.selections[selection] = {upload.buffers->light_selection,
-                                            upload.buffers->light_tree_nodes};
-        }
-        auto kept = upload.selections.find(selection);
-        if (kept == upload.selections.end()) {
-            DeviceUpload::Selection added;
-            added.buffer = upload_light_selection(device, host_data(), &added.tree_nodes);
-            kept = upload.selections.emplace(selection, added).first;
-        }
-        write_camera(device, *upload.buffers, data.camera);
-        GpuSceneBuffers buffers = *upload.buffers;  // handles, sharing the device's buffers
-        buffers.light_selection = kept->second.buffer;
-        buffers.light_tree_nodes = kept->second.tree_nodes;
-        return std::make_unique<DeviceWorker>(device, buffers, plan);
+RenderResult RenderSession::render(const std::shared_ptr<SessionScene>& scene,
+                                   const RenderPlan& plan, const ProgressSink& progress,
+                                   const RenderControl& control, const WarningSink& warn,
+                                   const RemoteWorkers& remote) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    SceneUploads& uploads = uploads_of(scene);
+    const WorkerFactory make = [&](const DeviceContext& device) {
+        return make_worker(uploads, *scene, plan, device);
     };
-    return render_with_workers(device_list_, make_worker, plan, progress, control, warn, remote);
+    return render_with_workers(device_list_, make, plan, progress, control, warn, remote);
+}
+
+void RenderSession::serve(const std::shared_ptr<SessionScene>& scene, const RenderPlan& plan,
+                          const Serve& serve, const WarningSink& warn) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    SceneUploads& uploads = uploads_of(scene);
+    std::vector<std::unique_ptr<DeviceWorker>> workers;
+    for (const DeviceContext* d : device_list_) {
+        try {
+            workers.push_back(make_worker(uploads, *scene, plan, *d));
+        } catch (const std::exception& e) {
+            if (warn)
+                warn("skipping device " + std::to_string(d->info.index) + " ('" + d->info.name +
+                     "'): " + e.what());
+        }
+    }
+    serve(workers);
 }
 
 }  // namespace mcrt

@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 CORNELL = str(ROOT / "scenes" / "cornell" / "CornellBox-Original.gltf")
@@ -134,3 +135,76 @@ def test_ctrl_c_during_a_load(tmp_path):
     assert "background 1" in lines
     assert "rendered 16" in lines
     assert out.read_bytes() == cli_bytes(tmp_path)
+
+
+# OpenCL's start-up in mcrt.Context() and mcrt.devices(), made to last (the test hook
+# MCRT_TEST_PAUSE=start-up, host/common/test_hooks.h) until the file MCRT_TEST_PAUSE_UNTIL
+# exists or PAUSE_SECONDS pass. A start-up that held the GIL would keep the other Python thread
+# (and the signal handler) from running for all of PAUSE_SECONDS, past the child's timeout.
+PAUSE_SECONDS = 300
+CHILD_TIMEOUT = 120
+
+STARTUP_CHILD = r"""
+import os, sys, threading, time
+import mcrt
+call, flag, stderr_file = sys.argv[1:4]
+def other():
+    # Runs once the start-up is in its pause (its line is in this process's stderr file).
+    while "paused at start-up" not in open(stderr_file).read():
+        time.sleep(0.01)
+    sys.stdout.write("thread ran\n")
+    sys.stdout.flush()
+    open(flag, "w").close()  # ends the start-up's pause
+if stderr_file:
+    threading.Thread(target=other).start()
+print("calling", flush=True)
+try:
+    mcrt.Context() if call == "Context" else mcrt.devices()
+    print("returned", flush=True)
+except KeyboardInterrupt:
+    print("interrupted", flush=True)
+    os._exit(0)  # the abandoned start-up sleeps on in the background
+"""
+
+
+def startup_child(tmp_path, call, flag, stderr_file=None):
+    """The child, its stderr in `stderr_file` (its other thread waits for the pause's line there)
+    or, without one, a pipe."""
+    env = dict(os.environ, MCRT_TEST_PAUSE="start-up", MCRT_TEST_PAUSE_SECONDS=str(PAUSE_SECONDS),
+               MCRT_TEST_PAUSE_UNTIL=str(flag), PYTHONUNBUFFERED="1")
+    return subprocess.Popen(
+        [sys.executable, "-c", STARTUP_CHILD, call, str(flag), str(stderr_file or "")],
+        stdout=subprocess.PIPE, text=True, env=env,
+        stderr=open(stderr_file, "w") if stderr_file else subprocess.PIPE)
+
+
+@pytest.mark.parametrize("call", ["Context", "devices"])
+def test_other_threads_run_during_opencl_start_up(tmp_path, call):
+    # The other thread, run during the pause, ends it: the call returns only once it has run.
+    stderr_file = tmp_path / "stderr"
+    child = startup_child(tmp_path, call, tmp_path / "flag", stderr_file)
+    try:
+        stdout, _ = child.communicate(timeout=CHILD_TIMEOUT)
+    finally:
+        if child.poll() is None:
+            child.kill()
+            child.wait()
+    assert child.returncode == 0, stderr_file.read_text()
+    assert stdout.split("\n")[:3] == ["calling", "thread ran", "returned"], stdout
+
+
+@pytest.mark.parametrize("call", ["Context", "devices"])
+def test_ctrl_c_during_opencl_start_up(tmp_path, call):
+    # The pause file never appears: only Ctrl-C ends the call before PAUSE_SECONDS.
+    child = startup_child(tmp_path, call, tmp_path / "never" / "flag")
+    try:
+        while "paused at start-up" not in child.stderr.readline():
+            assert child.poll() is None, child.stderr.read()
+        child.send_signal(signal.SIGINT)
+        stdout, stderr = child.communicate(timeout=CHILD_TIMEOUT)
+    finally:
+        if child.poll() is None:
+            child.kill()
+            child.wait()
+    assert child.returncode == 0, stderr
+    assert "interrupted" in stdout.split(), stdout

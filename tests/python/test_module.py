@@ -152,6 +152,41 @@ def test_environment_map_gives_the_cli_bytes(ctx, tmp_path):
     assert str(e.value) == cli_error(plane, "--out", "/tmp/unused.exr", "--env", missing)
 
 
+def test_environment_map_is_read_once_while_its_file_is_unchanged(tmp_path):
+    # The context keeps a map it read; a file rewritten in place (same size, a new mtime) is
+    # read again. Each render gives the command line's bytes for the file as it is then.
+    env = tmp_path / "kept.hdr"
+    plane = str(ROOT / "scenes" / "glossy" / "white-metal-plane.gltf")
+
+    def cli(name):
+        out = tmp_path / (name + ".exr")
+        run = subprocess.run([MCRT_EXE, "render", plane, "--out", str(out), "--quiet",
+                              "--env", str(env), "--estimator", "mis", "--width", "24",
+                              "--height", "24", "--spp", "16"], capture_output=True, text=True)
+        assert run.returncode == 0, run.stderr
+        return out.read_bytes()
+
+    with mcrt.Context() as ctx:
+        scene = ctx.load(plane)
+        reads = lambda: ctx._context._environment_reads
+        write_hdr(env, 16, 8, lambda i, j: (128, 128, 128, 132 if j == 2 else 129))
+        first = render_bytes(scene, tmp_path, "first", env=str(env), estimator="mis", **SMALL)
+        assert reads() == 1
+        again = render_bytes(scene, tmp_path, "again", env=str(env), estimator="mis", **SMALL)
+        assert reads() == 1
+        assert first == again == cli("first")
+        stat = env.stat()
+        write_hdr(env, 16, 8, lambda i, j: (128, 128, 128, 132 if i == 3 else 129))
+        os.utime(env, ns=(stat.st_atime_ns, stat.st_mtime_ns + 1000000000))
+        assert env.stat().st_size == stat.st_size
+        changed = render_bytes(scene, tmp_path, "changed", env=str(env), estimator="mis", **SMALL)
+        assert reads() == 2
+        assert changed == cli("changed") != first
+        # Another scale is another map (the texels are scaled as they are read).
+        scene.render(env=str(env), env_scale=2.0, estimator="mis", **SMALL)
+        assert reads() == 3
+
+
 def test_image_is_a_view_on_the_result(cornell):
     r = cornell.render(**SMALL)
     image, again = r.image, r.image
