@@ -233,8 +233,8 @@ PyResult render_scene(PyScene& self, const std::vector<std::string>& args,
                     if (!context->session)
                         throw PyDeviceError("the context of this scene is closed");
                     std::lock_guard<std::mutex> scene_lock(scene->use);
-                    const RenderPlan plan = plan_session_render(
-                        *scene, request, warn, {}, &context->session->environments());
+                    const RenderPlan plan = plan_session_render(*scene, request, warn, {},
+                                                                &context->session->environments());
                     check_host_memory(
                         "a " + std::to_string(o.width) + "x" + std::to_string(o.height) + " render",
                         render_host_bytes(o.width, o.height, plan.settings.replicates));

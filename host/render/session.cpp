@@ -70,18 +70,17 @@ RenderPlan plan_session_render(SessionScene& scene, const RenderRequest& request
             const Activity activity("loading the environment map");
             plan.environment = environments->load(s.env, s.env_scale, s.env_rotate);
         }
-        plan.environment_steps =
-            s.sky_light ? environment_pmf_steps(*plan.environment, prepared.gpu,
-                                                plan.variants.light_select->id)
-                        : 0;
+        plan.environment_steps = s.sky_light
+                                     ? environment_pmf_steps(*plan.environment, prepared.gpu,
+                                                             plan.variants.light_select->id)
+                                     : 0;
     } else {
         plan_environment(plan, prepared.gpu, source);
     }
     return finish_render_plan(std::move(plan), prepared.gpu);
 }
 
-std::optional<EnvironmentCache::FileIdentity> EnvironmentCache::identify(
-    const std::string& path) {
+std::optional<EnvironmentCache::FileIdentity> EnvironmentCache::identify(const std::string& path) {
     struct stat st {};
     if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return std::nullopt;
     FileIdentity id;
@@ -92,8 +91,8 @@ std::optional<EnvironmentCache::FileIdentity> EnvironmentCache::identify(
     return id;
 }
 
-std::shared_ptr<const EnvironmentLight> EnvironmentCache::load(const std::string& path,
-                                                               float scale, float rotate_deg) {
+std::shared_ptr<const EnvironmentLight> EnvironmentCache::load(const std::string& path, float scale,
+                                                               float rotate_deg) {
     std::lock_guard<std::mutex> lock(mutex_);
     const std::optional<FileIdentity> before = identify(path);
     auto kept = maps_.find(path);
@@ -154,8 +153,7 @@ size_t RenderSession::uploaded_scenes() const {
     return uploads_.size();
 }
 
-RenderSession::SceneUploads& RenderSession::uploads_of(
-    const std::shared_ptr<SessionScene>& scene) {
+RenderSession::SceneUploads& RenderSession::uploads_of(const std::shared_ptr<SessionScene>& scene) {
     // The buffers of scenes nobody holds any more go before anything is uploaded.
     for (auto it = uploads_.begin(); it != uploads_.end();)
         it = it->second.scene.expired() ? uploads_.erase(it) : std::next(it);
@@ -164,8 +162,7 @@ RenderSession::SceneUploads& RenderSession::uploads_of(
     return uploads;
 }
 
-std::unique_ptr<DeviceWorker> RenderSession::make_worker(SceneUploads& uploads,
-                                                         SessionScene& scene,
+std::unique_ptr<DeviceWorker> RenderSession::make_worker(SceneUploads& uploads, SessionScene& scene,
                                                          const RenderPlan& plan,
                                                          const DeviceContext& device) {
     GpuSceneData& data = scene.prepared.gpu;

@@ -77,7 +77,7 @@ class EnvironmentCache {
         uint64_t last_use = 0;
     };
     static constexpr size_t kMaxMaps = 4;  // a map of 8k x 4k texels holds 0.8 GB
-    std::map<std::string, Entry> maps_;   // by path: the last map read from it
+    std::map<std::string, Entry> maps_;    // by path: the last map read from it
     uint64_t uses_ = 0, reads_ = 0;
     mutable std::mutex mutex_;
 };
