@@ -136,7 +136,8 @@ std::string device_program_options(const DeviceInfo& device) {
     if (device.single_fp_config & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT)
         options += " -cl-fp32-correctly-rounded-divide-sqrt";
     // Intel's CPU runtime: kernels are not vectorised across work-items there unless
-    // MCRT_KERNEL_OPTIONS asks for it (-D MCRT_INTEL_VECTORIZE; kernels/shared_types.h says why).
+    // MCRT_KERNEL_OPTIONS asks for it (-D MCRT_INTEL_VECTORIZE; kernels/core/shared_types.h says
+    // why).
     if (device.platform_name.find("Intel(R) OpenCL") != std::string::npos)
         options += " -D MCRT_INTEL_CPU";
     return options;

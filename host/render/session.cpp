@@ -110,7 +110,7 @@ RenderResult RenderSession::render(const std::shared_ptr<SessionScene>& scene,
     // not got it yet: a sweep that returns to a selection finds it on the devices (a light
     // tree of 10^6 lights takes 2 s to build, docs/BENCHMARKS.md).
     auto host_data = [&]() -> const GpuSceneData& {
-        if (data.light_selection != selection) {
+        if (data.light_selection.selection != selection) {
             const Activity activity("laying out the scene for the devices");
             build_light_selection(data, selection);
         }
@@ -122,14 +122,15 @@ RenderResult RenderSession::render(const std::shared_ptr<SessionScene>& scene,
         if (!upload.buffers) {
             const GpuSceneData& selected = host_data();
             const Activity activity("uploading the scene");
-            upload.buffers = std::make_unique<GpuSceneBuffers>(device, selected);
+            upload.buffers = std::make_unique<GpuSceneBuffers>(device, selected, selection);
             upload.selections[selection] = {upload.buffers->light_selection,
                                             upload.buffers->light_tree_nodes};
         }
         auto kept = upload.selections.find(selection);
         if (kept == upload.selections.end()) {
             DeviceUpload::Selection added;
-            added.buffer = upload_light_selection(device, host_data(), &added.tree_nodes);
+            added.buffer =
+                upload_light_selection(device, host_data(), selection, &added.tree_nodes);
             kept = upload.selections.emplace(selection, added).first;
         }
         write_camera(device, *upload.buffers, data.camera);
