@@ -46,7 +46,7 @@ STAGES = [
      "    samples[g] = (uint4)(as_uint3(L), pack_path_record(&record));",
      "    if (as_uint(L.x) == 0x12345u) samples[g] = (uint4)(as_uint3(L), "
      "pack_path_record(&record));"),
-    ("pcg4d's second round (half the sample hashing)", "core/rng.cl",
+    ("pcg4d's second round (half the sample hashing)", "sampling/rng.cl",
      "    v ^= v >> 16u;\n    v.x += v.y * v.w;\n    v.y += v.z * v.x;\n    v.z += v.x * v.y;\n"
      "    v.w += v.y * v.z;\n    return v;",
      "    v ^= v >> 16u;\n    return v;"),
