@@ -162,7 +162,7 @@ inline float exact_hypot(float x, float y) {
 /* 2^x = 2^k · 2^f with k = rint(x) and f = x − k in [−1/2, 1/2] (both exact); 2^f = e^(f ln 2) by
  * its Taylor series to degree 7, whose remainder is below 6e-9 (0.1 ulp), in Horner form with
  * fma; then 2^k by ldexp (exact, or rounded once into the denormals). 0 for x ≤ −150, +∞ for
- * x ≥ 128, NaN for NaN. What Beer–Lambert attenuation needs (kernels/dielectric.cl). */
+ * x ≥ 128, NaN for NaN. What Beer–Lambert attenuation needs (kernels/materials/dielectric.cl). */
 inline float exact_exp2(float x) {
     if (x != x) return x;
     if (x <= -150.0f) return 0.0f;
