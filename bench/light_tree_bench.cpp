@@ -18,8 +18,8 @@
 #include "cl/cl_error.h"
 #include "cl/device.h"
 #include "cl/program.h"
-#include "render/discrete.h"
-#include "render/light_tree.h"
+#include "lights/discrete.h"
+#include "lights/light_tree.h"
 
 using namespace mcrt;
 

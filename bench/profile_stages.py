@@ -30,23 +30,23 @@ import mcrt_run  # noqa: E402
 
 # (stage, file, text, replacement): the variant without the stage.
 STAGES = [
-    ("shadow ray (any hit)", "estimators.cl",
+    ("shadow ray (any hit)", "estimators/estimators.cl",
      "        if (light_sample_visible(scene, sp, &ls)) {\n            float pdf_light = "
      "light_sample_pdf_w(&ls);",
      "        if (true) {\n            float pdf_light = light_sample_pdf_w(&ls);"),
-    ("BSDF ray (closest hit and its surface point)", "estimators.cl",
+    ("BSDF ray (closest hit and its surface point)", "estimators/estimators.cl",
      "        if (trace_bsdf_sample(scene, sp, &bs, rays, &seen)) {\n            float3 Le = "
      "emitted_radiance(&seen);",
      "        if (as_uint(bs.wi.x) == 0x12345u && trace_bsdf_sample(scene, sp, &bs, rays, "
      "&seen)) {\n            float3 Le = emitted_radiance(&seen);"),
-    ("the estimator (light and BSDF sampling, both rays, MIS)", "path.cl",
+    ("the estimator (light and BSDF sampling, both rays, MIS)", "estimators/path.cl",
      "        L += beta * MCRT_ESTIMATE(scene, &sp, stream, &record->rays);",
      "        L += beta * sp.n;"),
-    ("the sample's store", "render.cl",
+    ("the sample's store", "render/render.cl",
      "    samples[g] = (uint4)(as_uint3(L), pack_path_record(&record));",
      "    if (as_uint(L.x) == 0x12345u) samples[g] = (uint4)(as_uint3(L), "
      "pack_path_record(&record));"),
-    ("pcg4d's second round (half the sample hashing)", "rng.cl",
+    ("pcg4d's second round (half the sample hashing)", "sampling/rng.cl",
      "    v ^= v >> 16u;\n    v.x += v.y * v.w;\n    v.y += v.z * v.x;\n    v.z += v.x * v.y;\n"
      "    v.w += v.y * v.z;\n    return v;",
      "    v ^= v >> 16u;\n    return v;"),

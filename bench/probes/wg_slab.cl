@@ -1,7 +1,7 @@
 /* Probe for docs/BENCHMARKS.md ("Where a sample's time goes", its work-group bullet): does PoCL's work-item
  * loop vectoriser make a slab test cheaper when a work-group tests one node for all its rays?
  * Both kernels test every ray against the same NODES 4-wide nodes (random boxes), with the
- * arithmetic of bvh4_entry (kernels/bvh_traverse.cl).
+ * arithmetic of bvh4_entry (kernels/traversal/bvh_traverse.cl).
  *   slab_group:  scalar code per child, one node per barrier-separated region, and a vote in
  *                local memory (work-item 0 ORs the masks), as a group traversal would need:
  *                the regions between barriers are loop-free, so PoCL vectorises them across

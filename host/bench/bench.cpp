@@ -46,7 +46,7 @@ struct Timing {
     }
 };
 
-// mcrt's BVH on one OpenCL device, tracing with kernels/trace.cl.
+// mcrt's BVH on one OpenCL device, tracing with kernels/traversal/trace.cl.
 class DeviceTracer {
   public:
     DeviceTracer(const DeviceInfo& info, const Bvh& bvh) : device_(info) {

@@ -1,6 +1,7 @@
 #include "cl/program.h"
 
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <mutex>
@@ -19,12 +20,28 @@ namespace mcrt {
 // On a driver that caches kernels itself (PoCL), the binary is stored at this miss of a variant.
 constexpr int kDriverCachesStoreAfterMisses = 3;
 
-const std::map<std::string, std::string>& embedded_kernel_files();  // generated at build time
+// Generated at build time (cmake/embed_kernels.cmake): the library the executable links holds
+// kernels/ alone (mcrt_kernels) or with the test and bench kernels (mcrt_test_kernels).
+const std::map<std::string, std::string>& embedded_kernel_files();
+
+// The file called `name` under `dir` or one of its folders (kernels/ groups files by concept;
+// names are unique, as the build checks for the embedded copies); empty when there is none.
+static std::filesystem::path find_kernel_file(const std::string& dir, const std::string& name) {
+    std::error_code error;
+    std::filesystem::path direct = std::filesystem::path(dir) / name;
+    if (std::filesystem::is_regular_file(direct, error)) return direct;
+    for (std::filesystem::recursive_directory_iterator it(dir, error), end; !error && it != end;
+         it.increment(error))
+        if (it->path().filename() == name && it->is_regular_file(error)) return it->path();
+    return {};
+}
 
 static std::string read_kernel_file(const std::string& name) {
     if (const char* dir = environment(kEnvKernelDir); dir && *dir) {
-        std::ifstream in(std::string(dir) + "/" + name, std::ios::binary);
-        if (!in) throw RuntimeError("kernel file not found: " + std::string(dir) + "/" + name);
+        const std::filesystem::path path = find_kernel_file(dir, name);
+        std::ifstream in(path, std::ios::binary);
+        if (path.empty() || !in)
+            throw RuntimeError("kernel file not found: " + std::string(dir) + "/" + name);
         std::ostringstream text;
         text << in.rdbuf();
         return text.str();
@@ -119,7 +136,8 @@ std::string device_program_options(const DeviceInfo& device) {
     if (device.single_fp_config & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT)
         options += " -cl-fp32-correctly-rounded-divide-sqrt";
     // Intel's CPU runtime: kernels are not vectorised across work-items there unless
-    // MCRT_KERNEL_OPTIONS asks for it (-D MCRT_INTEL_VECTORIZE; kernels/shared_types.h says why).
+    // MCRT_KERNEL_OPTIONS asks for it (-D MCRT_INTEL_VECTORIZE; kernels/core/shared_types.h says
+    // why).
     if (device.platform_name.find("Intel(R) OpenCL") != std::string::npos)
         options += " -D MCRT_INTEL_CPU";
     return options;

@@ -17,10 +17,11 @@ struct KernelFile {
 };
 using KernelReplacements = std::map<std::string, KernelFile>;  // by the file name #include uses
 
-// Source of kernels/<file> with every #include "..." expanded once (include guards are not
-// needed) and #line markers, so build errors name the right file and line. The files are those
-// embedded at build time, or those of $MCRT_KERNEL_DIR when set (development override), except
-// those in `replacements`. Throws RuntimeError when a file is missing.
+// Source of the kernel file `file` (by name, in whichever folder of kernels/) with every #include
+// "..." expanded once (include guards are not needed) and #line markers, so build errors name the
+// right file and line. The files are those embedded at build time, or those of $MCRT_KERNEL_DIR
+// when set (development override), except those in `replacements`. Throws RuntimeError when a file
+// is missing.
 std::string kernel_source(const std::string& file, const KernelReplacements& replacements = {});
 
 // Builds source for the context's device with the options. A failing build throws

@@ -100,7 +100,7 @@ std::string help_list(const char* what, const Table& table) {
     return text;
 }
 
-// Non-finite samples are counted as 0 (kernels/render.cl, reduce_chunks): say so, and refuse
+// Non-finite samples are counted as 0 (kernels/render/render.cl, reduce_chunks): say so, and refuse
 // an image that holds nothing else.
 void report_nonfinite_samples(uint64_t nonfinite, uint64_t samples, const WarningSink& warn) {
     if (nonfinite == 0 || samples == 0) return;

@@ -21,8 +21,9 @@ void test_pause(const char* point);
 bool test_no_tmpfile();
 
 // True when MCRT_TEST_WRONG_DEVICE names device index `device`: its render programs are built
-// with -D MCRT_TEST_WRONG_VALUES, which scales every sample by 1 + 2^-20 (kernels/render.cl), a
-// device that computes slightly wrong values for the agreement check to catch.
+// with -D MCRT_TEST_WRONG_VALUES, which scales every sample by 1 + 2^-20
+// (kernels/render/render.cl), a device that computes slightly wrong values for the agreement check
+// to catch.
 bool test_wrong_device(int device);
 
 // True when MCRT_TEST_COMPILER_CRASH names device index `device`: a child build for it

@@ -107,7 +107,7 @@ void Accumulator::apply(const BatchResult& r) {
                     part.n = n;  // the same for every pixel of a row: its chunk, over K
                     part.nan += uint64_t(s.shift.w);
                     part.rays += uint64_t(s.sum.w);
-                    // Path vertices + 2^15 × roulette ends (kernels/shared_types.h).
+                    // Path vertices + 2^15 × roulette ends (kernels/core/shared_types.h).
                     const uint64_t path = uint64_t(s.exponent.w);
                     part.vertices += path & 0x7fff;
                     part.roulette += path >> 15;

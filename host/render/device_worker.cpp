@@ -66,11 +66,8 @@ DeviceWorker::DeviceWorker(const DeviceContext& device, const GpuSceneData& scen
       fixed_batch_(plan.fixed_batch),
       fail_at_launch_(test_fault_launch(device.info.index)),
       slow_factor_(test_slow_factor(device.info.index)) {
-    if (scene.light_selection != plan.variants.light_select->id)
-        throw RuntimeError("the device scene holds the data of another light selection than " +
-                           plan.settings.light_select + "'s");
     build(plan);
-    buffers_ = std::make_unique<GpuSceneBuffers>(device, scene);
+    buffers_ = std::make_unique<GpuSceneBuffers>(device, scene, plan.variants.light_select->id);
     set_up(plan);
 }
 

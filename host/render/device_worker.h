@@ -17,8 +17,8 @@
 
 namespace mcrt {
 
-// Binds the render kernel's buffers in the order of RenderArgument (kernels/shared_types.h); the
-// per-launch RenderParams are set with each launch.
+// Binds the render kernel's buffers in the order of RenderArgument (kernels/core/shared_types.h);
+// the per-launch RenderParams are set with each launch.
 void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene,
                            const cl::Buffer& environment, const cl::Buffer& samples);
 

@@ -6,8 +6,6 @@
 #include <cstring>
 
 #include "cl/cl_error.h"
-#include "render/discrete.h"
-#include "render/light_tree.h"
 #include "scene/texture_lookup.h"
 
 namespace mcrt {
@@ -154,7 +152,7 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
         g.alpha = alpha;
         g.type = m.lambertian() ? MATERIAL_LAMBERTIAN : MATERIAL_METALLIC_ROUGHNESS;
         g.flags = m.double_sided ? MATERIAL_DOUBLE_SIDED : 0u;
-        // KHR_materials_transmission, _ior, _volume (kernels/bsdf.cl, dielectric.cl).
+        // KHR_materials_transmission, _ior, _volume (kernels/materials/bsdf.cl, dielectric.cl).
         g.transmission = m.transmission;
         g.ior = m.ior;
         if (m.transmission > 0.0f && m.volume) {
@@ -295,46 +293,12 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
     return data;
 }
 
-void build_light_selection(GpuSceneData& data, LightSelection selection) {
-    data.light_selection = selection;
-    data.light_cdf.clear();
-    data.light_alias.clear();
-    data.light_tree = LightTree{};
-    const std::vector<double>& powers = data.light_powers;
-    switch (selection) {
-        case LightSelection::Uniform:
-            break;
-        case LightSelection::Power:
-            data.light_cdf = build_cdf(powers);
-            break;
-        case LightSelection::Alias:
-            data.light_alias = build_alias_table(powers);
-            break;
-        case LightSelection::Tree:
-            data.light_tree = build_light_tree(data.lights, powers, 0, data.punctual_tree_items);
-            break;
-    }
+static LightSelectionInputs light_selection_inputs(const GpuSceneData& data) {
+    return {data.lights, data.light_powers, data.punctual_tree_items};
 }
 
-std::vector<uint32_t> light_selection_words(const GpuSceneData& data, uint32_t* tree_nodes) {
-    *tree_nodes = 0;
-    auto words = [](const auto& items) {
-        std::vector<uint32_t> w(items.size() * sizeof(items[0]) / sizeof(uint32_t));
-        if (!items.empty()) std::memcpy(w.data(), items.data(), w.size() * sizeof(uint32_t));
-        return w;
-    };
-    switch (data.light_selection) {
-        case LightSelection::Uniform:
-            return {};
-        case LightSelection::Power:
-            return words(data.light_cdf);
-        case LightSelection::Alias:
-            return words(data.light_alias);
-        case LightSelection::Tree:
-            *tree_nodes = uint32_t(std::max<size_t>(data.light_tree.nodes.size(), 1));
-            return light_tree_words(data.light_tree);
-    }
-    return {};
+void build_light_selection(GpuSceneData& data, LightSelection selection) {
+    data.light_selection = build_light_selection(selection, light_selection_inputs(data));
 }
 
 template <typename T>
@@ -355,14 +319,25 @@ static cl::Buffer upload(const DeviceContext& device, const std::vector<T>& item
     return buffer;
 }
 
-GpuSceneBuffers::GpuSceneBuffers(const DeviceContext& device, const GpuSceneData& data) {
+// The one place where a scene's selection data meets the selection a render asks for.
+static cl::Buffer upload_selection(const DeviceContext& device, const GpuSceneData& data,
+                                   LightSelection selection, size_t& bytes, cl_uint* tree_nodes) {
+    *tree_nodes = 0;
+    if (data.light_selection.selection == selection)
+        return upload(device, light_selection_words(data.light_selection, tree_nodes), bytes,
+                      "light selection data");
+    const LightSelectionData built = build_light_selection(selection, light_selection_inputs(data));
+    return upload(device, light_selection_words(built, tree_nodes), bytes, "light selection data");
+}
+
+GpuSceneBuffers::GpuSceneBuffers(const DeviceContext& device, const GpuSceneData& data,
+                                 LightSelection selection) {
     nodes = upload(device, data.nodes, bytes, "BVH nodes");
     packets = upload(device, data.packets, bytes, "triangle packets");
     triangle_info = upload(device, data.triangle_info, bytes, "triangle materials and lights");
     materials = upload(device, data.materials, bytes, "materials");
     lights = upload(device, data.lights, bytes, "lights");
-    light_selection = upload(device, light_selection_words(data, &light_tree_nodes), bytes,
-                             "light selection data");
+    light_selection = upload_selection(device, data, selection, bytes, &light_tree_nodes);
     surfaces = upload(device, data.surfaces, bytes, "texture coordinates and tangents");
     textures = upload(device, data.textures, bytes, "textures");
     punctual = upload(device, data.punctual, bytes, "punctual lights");
@@ -372,10 +347,9 @@ GpuSceneBuffers::GpuSceneBuffers(const DeviceContext& device, const GpuSceneData
 }
 
 cl::Buffer upload_light_selection(const DeviceContext& device, const GpuSceneData& data,
-                                  cl_uint* tree_nodes) {
+                                  LightSelection selection, cl_uint* tree_nodes) {
     size_t bytes = 0;
-    *tree_nodes = 0;
-    return upload(device, light_selection_words(data, tree_nodes), bytes, "light selection data");
+    return upload_selection(device, data, selection, bytes, tree_nodes);
 }
 
 void write_camera(const DeviceContext& device, const GpuSceneBuffers& buffers,

@@ -1,4 +1,4 @@
-// The scene as the kernels see it: host arrays in the layouts of kernels/shared_types.h, and
+// The scene as the kernels see it: host arrays in the layouts of kernels/core/shared_types.h, and
 // their buffers on one device.
 #pragma once
 
@@ -8,7 +8,7 @@
 
 #include "bvh/bvh.h"
 #include "cl/device.h"
-#include "render/light_tree.h"
+#include "lights/light_selection.h"
 #include "render/variants.h"
 #include "scene/scene.h"
 #include "shared_types.h"
@@ -25,15 +25,10 @@ struct GpuSceneData {
     // a scene with any gets kernels that draw them (-D MCRT_PUNCTUAL), one without none.
     std::vector<gpu::PunctualGpu> punctual;
     std::vector<LightTreeItem> punctual_tree_items;  // their bounds in the light tree
-    // The light selection's own data, only that of `light_selection` built: power's CDF
-    // (lights + 1 entries, PBRT 3rd ed. 13.3.1), alias's table of the same distribution, or the
-    // tree (render/light_tree.h); uniform has none.
-    LightSelection light_selection = LightSelection::Power;
     std::vector<double> light_powers;  // one per light, then per punctual light: what every
                                        // selection is built from
-    std::vector<float> light_cdf;
-    std::vector<gpu::AliasEntry> light_alias;
-    LightTree light_tree;
+    // The data of one light selection (lights/light_selection.h), as make_gpu_scene was asked.
+    LightSelectionData light_selection;
     gpu::CameraGpu camera{};
     // Some material's type is not MATERIAL_LAMBERTIAN: the kernels need that model (-D
     // MCRT_MATERIALS_GLTF); a Lambertian scene's kernels are built without it.
@@ -61,17 +56,15 @@ gpu::CameraGpu make_gpu_camera(const Camera& camera, int width, int height);
 GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& camera, int width,
                             int height, LightSelection selection = LightSelection::Power);
 
-// Replaces the light selection's data with that of `selection` (a device scene built for one
-// selection, rendered with another).
+// Replaces the light selection's data with that of `selection`: a scene kept for several
+// selections holds one at a time (render/session.h).
 void build_light_selection(GpuSceneData& data, LightSelection selection);
 
-// The light selection's buffer as the kernels read it (RENDER_ARG_LIGHT_SELECTION), in 32-bit
-// words; `tree_nodes` the nodes at its head for the tree, else 0.
-std::vector<uint32_t> light_selection_words(const GpuSceneData& data, uint32_t* tree_nodes);
-
-// Device copies of GpuSceneData (empty arrays get a one-element buffer, never a null one).
+// Device copies of GpuSceneData (empty arrays get a one-element buffer, never a null one), with
+// the data of light selection `selection` (upload_light_selection).
 struct GpuSceneBuffers {
-    GpuSceneBuffers(const DeviceContext& device, const GpuSceneData& data);
+    GpuSceneBuffers(const DeviceContext& device, const GpuSceneData& data,
+                    LightSelection selection);
     cl::Buffer nodes, packets, triangle_info, materials, lights, light_selection, surfaces,
         textures, punctual, camera;
     cl_uint light_count = 0;     // area lights
@@ -80,10 +73,12 @@ struct GpuSceneBuffers {
     size_t bytes = 0;
 };
 
-// The light selection's buffer of `data` alone, for a device scene kept for several selections
-// (render/session.h); `tree_nodes` as light_selection_words sets it.
+// The buffer of light selection `selection` for `data` (RENDER_ARG_LIGHT_SELECTION), `tree_nodes`
+// as light_selection_words sets it: the data's own when it holds that selection's, else built
+// here, so that a scene built for one selection renders right with another. Every upload of a
+// selection goes through here.
 cl::Buffer upload_light_selection(const DeviceContext& device, const GpuSceneData& data,
-                                  cl_uint* tree_nodes);
+                                  LightSelection selection, cl_uint* tree_nodes);
 
 // Writes the camera of a render into the device scene's camera buffer, waiting for the copy.
 void write_camera(const DeviceContext& device, const GpuSceneBuffers& buffers,

@@ -1,6 +1,6 @@
 // The render program of a render's plan: its -D options (RenderPlan::program_options), a user's
-// estimator file in place of kernels/user_estimator.cl (checked by render/estimator_file.h), and
-// its build on one device.
+// estimator file in place of kernels/estimators/user_estimator.cl (checked by
+// render/estimator_file.h), and its build on one device.
 #pragma once
 
 #include <CL/opencl.hpp>
@@ -17,10 +17,10 @@ struct RenderPlan;
 
 // Probability that the light strategies choose the sky light (RenderParams::sky.w): 0 when the
 // sky is no light, 1 when it is the only one, else 1/2 beside the area lights, the exact split of
-// the selection sample (kernels/light_sampling.cl, select_sky).
+// the selection sample (kernels/lights/light_sampling.cl, select_sky).
 float sky_light_pmf(const RenderSettings& settings, uint32_t light_count);
 
-// The user's estimator file, if any, as the replacement of kernels/user_estimator.cl.
+// The user's estimator file, if any, as the replacement of kernels/estimators/user_estimator.cl.
 KernelReplacements render_program_replacements(const RenderSettings& settings);
 
 // The render program built (once per process) for the device. A build error in a user's

@@ -47,12 +47,6 @@ RenderResult render(const std::vector<const DeviceContext*>& devices, const GpuS
                     const RenderControl& control,
                     const std::function<void(const std::string&)>& warn,
                     const RemoteWorkers& remote) {
-    if (scene.light_selection != plan.variants.light_select->id) {
-        // A device scene built for another light selection: its data for this one.
-        GpuSceneData rebuilt = scene;
-        build_light_selection(rebuilt, plan.variants.light_select->id);
-        return render(devices, rebuilt, plan, progress, control, warn, remote);
-    }
     return render_with_workers(
         devices,
         [&](const DeviceContext& d) { return std::make_unique<DeviceWorker>(d, scene, plan); },

@@ -171,7 +171,7 @@ std::unique_ptr<DeviceWorker> RenderSession::make_worker(SceneUploads& uploads, 
     // not got it yet: a sweep that returns to a selection finds it on the devices (a light
     // tree of many lights is slow to build: docs/BENCHMARKS.md, "Light selection").
     auto host_data = [&]() -> const GpuSceneData& {
-        if (data.light_selection != selection) {
+        if (data.light_selection.selection != selection) {
             const Activity activity("laying out the scene for the devices");
             build_light_selection(data, selection);
         }
@@ -181,7 +181,7 @@ std::unique_ptr<DeviceWorker> RenderSession::make_worker(SceneUploads& uploads, 
     if (!upload.buffers) {
         const GpuSceneData& selected = host_data();
         const Activity activity("uploading the scene");
-        upload.buffers = std::make_unique<GpuSceneBuffers>(device, selected);
+        upload.buffers = std::make_unique<GpuSceneBuffers>(device, selected, selection);
         upload.selections[selection] = {upload.buffers->light_selection,
                                         upload.buffers->light_tree_nodes};
     }

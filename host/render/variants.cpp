@@ -21,7 +21,7 @@ EstimatorVariant ambient(const char* name, const char* function, unsigned uses,
 
 }  // namespace
 
-// DESIGN.md "Estimators"; the kernel functions are in kernels/estimators.cl.
+// DESIGN.md "Estimators"; the kernel functions are in kernels/estimators/estimators.cl.
 const std::vector<EstimatorVariant> kEstimatorVariants = {
     reflected("hemisphere-uniform", "estimate_hemisphere_uniform", kUsesLights,
               "directions uniform on the hemisphere, pdf 1/(2 pi), counting the emitters they "

@@ -14,7 +14,7 @@
 
 #include "common/error.h"
 #include "common/value_limits.h"
-#include "render/discrete.h"
+#include "lights/discrete.h"
 
 namespace mcrt {
 
@@ -209,7 +209,8 @@ EnvironmentDistribution build_environment_distribution(const EnvironmentMap& map
 
 std::array<double, 3> sample_environment(const EnvironmentDistribution& dist, double u0, double u1,
                                          double u2, double rotate_deg) {
-    // Largest k with cdf[k] <= u0 among non-empty intervals (kernels/discrete.cl's inversion).
+    // Largest k with cdf[k] <= u0 among non-empty intervals (kernels/sampling/discrete.cl's
+    // inversion).
     const auto it = std::upper_bound(dist.cdf.begin(), dist.cdf.end(), float(u0));
     size_t k = size_t(std::max<ptrdiff_t>(it - dist.cdf.begin() - 1, 0));
     k = std::min(k, dist.cdf.size() - 2);

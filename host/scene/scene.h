@@ -99,8 +99,8 @@ inline float dielectric_f0(float ior) {
 }
 
 // Beer–Lambert attenuation per unit length in bits, −log2(attenuationColor)/attenuationDistance
-// per channel (transmittance 2^(−a·t), kernels/dielectric.cl): 0 for an infinite distance or a
-// white colour; a black channel's is large but finite (1e30), so that a·0 stays 0.
+// per channel (transmittance 2^(−a·t), kernels/materials/dielectric.cl): 0 for an infinite distance
+// or a white colour; a black channel's is large but finite (1e30), so that a·0 stays 0.
 inline glm::dvec3 volume_attenuation(const Material& m) {
     glm::dvec3 a(0.0);
     if (!std::isfinite(m.attenuation_distance)) return a;

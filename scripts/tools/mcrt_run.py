@@ -241,15 +241,16 @@ def use_module(binary=None, cli=False):
         print("%s: the module %s is not %s's: rendering with commands"
               % (os.path.basename(sys.argv[0]), module.__file__, binary), file=sys.stderr)
         return None
-    # A module linked before the library it shares with the executable (only `mcrt` rebuilt
-    # after a change) would render with the old kernels.
-    core = Path(binary).parent / "libmcrt_core.a"
+    # A module linked before the libraries it shares with the executable (only `mcrt` rebuilt
+    # after a change) would render with the old host code or the old kernels.
     extension = Path(module._mcrt.__file__)
-    if core.is_file() and extension.stat().st_mtime < core.stat().st_mtime:
-        print("%s: the module %s is older than %s (cmake --build %s --target mcrt_python): "
-              "rendering with commands" % (os.path.basename(sys.argv[0]), extension, core,
-                                           Path(binary).parent), file=sys.stderr)
-        return None
+    for name in ("libmcrt_core.a", "libmcrt_kernels.a"):
+        shared = Path(binary).parent / name
+        if shared.is_file() and extension.stat().st_mtime < shared.stat().st_mtime:
+            print("%s: the module %s is older than %s (cmake --build %s --target mcrt_python): "
+                  "rendering with commands" % (os.path.basename(sys.argv[0]), extension, shared,
+                                               Path(binary).parent), file=sys.stderr)
+            return None
     _MODULE.update(module=module, binary=binary)
     print("%s: rendering through the Python module in %s (--cli: a command per render)"
           % (os.path.basename(sys.argv[0]), os.path.dirname(os.path.dirname(module.__file__))),

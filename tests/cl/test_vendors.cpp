@@ -43,7 +43,7 @@ TEST_CASE("every OpenCL implementation renders the same bytes, alone and togethe
     if (platforms.size() < 2)
         skip_test("one OpenCL implementation present (run under scripts/with-intel for two)");
     // An environment map of a dim sky and a few bright texels (a sun), for the map's lookup and
-    // its texel sampling (kernels/environment.cl).
+    // its texel sampling (kernels/lights/environment.cl).
     TempDir maps;
     Image map(32, 16);
     for (size_t k = 0; k < map.rgb.size(); ++k) map.rgb[k] = (k / 3) % 97 < 2 ? 500.0f : 0.4f;

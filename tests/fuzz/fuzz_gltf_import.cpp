@@ -12,7 +12,7 @@
 
 #include "bvh/bvh.h"
 #include "common/error.h"
-#include "render/discrete.h"
+#include "lights/discrete.h"
 #include "scene/gltf_import.h"
 #include "scene/scene.h"
 

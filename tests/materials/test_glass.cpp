@@ -1,6 +1,6 @@
-// Glass: KHR_materials_ior, _transmission and _volume (kernels/bsdf.cl, -D MCRT_TRANSMISSION):
-// what the importer reads and refuses, the F0 the index of refraction gives every dielectric,
-// and scenes without these extensions unchanged.
+// Glass: KHR_materials_ior, _transmission and _volume (kernels/materials/bsdf.cl, -D
+// MCRT_TRANSMISSION): what the importer reads and refuses, the F0 the index of refraction gives
+// every dielectric, and scenes without these extensions unchanged.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstdio>

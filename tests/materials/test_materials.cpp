@@ -1,5 +1,5 @@
-// glTF 2.0 metallic-roughness materials (kernels/bsdf.cl, -D MCRT_MATERIALS_GLTF): the GGX
-// distribution's normalisations (a weak white furnace), χ² of BSDF sampling against its pdf
+// glTF 2.0 metallic-roughness materials (kernels/materials/bsdf.cl, -D MCRT_MATERIALS_GLTF): the
+// GGX distribution's normalisations (a weak white furnace), χ² of BSDF sampling against its pdf
 // twin, reciprocity, energy, finite values at the extremes, the kernel against an independent
 // double-precision implementation of the specification's formulas, every direct estimator
 // unbiased on glossy planes under a quad light, and Lambertian scenes bitwise unchanged.

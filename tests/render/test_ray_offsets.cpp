@@ -1,5 +1,5 @@
-// Rays that leave surfaces at every scale (kernels/geometry.cl, intersect.cl): the quad light over
-// floors 1 m to 100 km wide, the whole scene scaled from 10^-3 to 10^3 and moved up to 10^4 m
+// Rays that leave surfaces at every scale (kernels/core/geometry.cl, intersect.cl): the quad light
+// over floors 1 m to 100 km wide, the whole scene scaled from 10^-3 to 10^3 and moved up to 10^4 m
 // from the origin, a grazing view over large floors, a large emitting plane, and a box resting
 // on a floor — each against its exact image (Lambert's formula), band by band, within the
 // renders' own standard errors, for every strategy that spawns rays.

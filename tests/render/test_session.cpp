@@ -74,7 +74,7 @@ TEST_CASE("a session renders one loaded scene under many requests, each as a fre
     CHECK(session.uploaded_scenes() == 1);
     // The last render's selection (power) was on the device already: the host still holds the
     // data of the last one it built (uniform's, which has none to build), not power's again.
-    CHECK(scene->prepared.gpu.light_selection == LightSelection::Uniform);
+    CHECK(scene->prepared.gpu.light_selection.selection == LightSelection::Uniform);
 
     // A scene nobody holds loses its buffers at the next render.
     auto other = load_session_scene(kCornell, "lambert", LightSelection::Power, SceneSource{}, {});

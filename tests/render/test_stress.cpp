@@ -362,8 +362,9 @@ TEST_CASE("stress: zero-area emitters are not lights", "[stress][scene]") {
     CHECK(emitters.size() == 5);
     Bvh bvh = build_bvh(scene);
     GpuSceneData data = make_gpu_scene(scene, bvh, scene.cameras.front(), 16, 16);
-    REQUIRE(data.light_cdf.size() == emitters.size() + 1);
-    for (size_t i = 0; i < emitters.size(); ++i) CHECK(data.light_cdf[i + 1] > data.light_cdf[i]);
+    REQUIRE(data.light_selection.cdf.size() == emitters.size() + 1);
+    for (size_t i = 0; i < emitters.size(); ++i)
+        CHECK(data.light_selection.cdf[i + 1] > data.light_selection.cdf[i]);
 }
 
 TEST_CASE("stress scenes through the executable: exit 0, finite EXR, nan_samples 0",

@@ -1,10 +1,10 @@
-// kernels/exact_math.cl on every OpenCL device (entry points in kernels/exact_math_test.cl):
-// max ulp error of sinpi, cospi, atan2 and hypot against long double references over dense
-// grids, random floats and edge cases; exact values at the special points; symmetry. Bit for bit
-// the functions must not depend on the device or its optimiser: each device's results equal
-// those of the same device built with -cl-opt-disable, and those of the same source compiled
-// for the host by the C++ compiler (the host twin below). Under scripts/with-intel both PoCL
-// and Intel's CPU runtime are checked.
+// kernels/core/exact_math.cl on every OpenCL device (entry points in
+// tests/kernels/exact_math_test.cl): max ulp error of sinpi, cospi, atan2 and hypot against long
+// double references over dense grids, random floats and edge cases; exact values at the special
+// points; symmetry. Bit for bit the functions must not depend on the device or its optimiser: each
+// device's results equal those of the same device built with -cl-opt-disable, and those of the same
+// source compiled for the host by the C++ compiler (the host twin below). Under scripts/with-intel
+// both PoCL and Intel's CPU runtime are checked.
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cfloat>

@@ -1,5 +1,5 @@
-// The sampling routines of kernels/sampling.cl, discrete.cl and frame.cl run on the device
-// (entry points in kernels/sampling_test.cl): each pdf integrates to 1, χ² tests of samples
+// The sampling routines of kernels/sampling/sampling.cl, discrete.cl and frame.cl run on the device
+// (entry points in tests/kernels/sampling_test.cl): each pdf integrates to 1, χ² tests of samples
 // against the pdf twin, inverses round-trip, discrete samplers report their own pmf, and the
 // Fibonacci spiral converges faster than uniform sampling.
 #include <algorithm>
@@ -16,8 +16,8 @@
 #include "cl/program.h"
 #include "device_support.h"
 #include "kernel_program.h"
-#include "render/discrete.h"
-#include "render/light_tree.h"
+#include "lights/discrete.h"
+#include "lights/light_tree.h"
 
 using namespace mcrt;
 using namespace mcrt::test;
@@ -704,7 +704,7 @@ TEST_CASE("build_cdf and build_alias_table", "[sampling][discrete]") {
         CHECK(cdf.front() == 0.0f);
         CHECK(cdf.back() == 1.0f);
         for (size_t i = 0; i < w.size(); ++i) {
-            // On the grid of u (kernels/rng.cl), so the interval's width is exactly the
+            // On the grid of u (kernels/sampling/rng.cl), so the interval's width is exactly the
             // probability that u falls in it; positive weights are never left out.
             CHECK(double(cdf[i + 1]) * 0x1.0p24 == std::floor(double(cdf[i + 1]) * 0x1.0p24));
             if (w[i] == 0) CHECK(cdf[i] == cdf[i + 1]);
@@ -712,7 +712,8 @@ TEST_CASE("build_cdf and build_alias_table", "[sampling][discrete]") {
             CHECK(std::abs((cdf[i + 1] - cdf[i]) - w[i] / total) <= 0x1.0p-23);
         }
         // Every k of the kernels' 2^24 grid through sample_discrete_alias's integer mapping
-        // (kernels/discrete.cl): the count of k giving i is the table's pmf · 2^24, exactly.
+        // (kernels/sampling/discrete.cl): the count of k giving i is the table's pmf · 2^24,
+        // exactly.
         std::vector<gpu::AliasEntry> table = build_alias_table(w);
         REQUIRE(table.size() == w.size());
         const uint64_t n = w.size();

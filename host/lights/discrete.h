@@ -1,5 +1,5 @@
-// Discrete distributions for the kernels' samplers (kernels/discrete.cl): a CDF for inversion by
-// binary search and an alias table, both built from non-negative weights.
+// Discrete distributions for the kernels' samplers (kernels/sampling/discrete.cl): a CDF for
+// inversion by binary search and an alias table, both built from non-negative weights.
 #pragma once
 
 #include <vector>

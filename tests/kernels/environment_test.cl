@@ -1,4 +1,4 @@
-/* Test entry points for kernels/environment.cl (tests/test_environment.cpp). Global sizes are
+/* Test entry points for kernels/lights/environment.cl (tests/scene/test_environment.cpp). Global sizes are
  * 1D; each entry checks its bound. */
 #include "environment.cl"
 

@@ -13,7 +13,7 @@
  * exact_cospi 0.72, exact_atan2 0.70 (0.86 where y/x nears the underflow threshold),
  * exact_hypot 1.02 (bound 1.25) — sinpi's and cospi's kernels on every float of [0, 1/4],
  * atan2 on every ratio of [0, 1] in each octant and on 2e8 random pairs, hypot on 2e8; and
- * tests/test_exact_math.cpp on every device. */
+ * tests/sampling/test_exact_math.cpp on every device. */
 #ifndef MCRT_EXACT_MATH_CL
 #define MCRT_EXACT_MATH_CL
 
@@ -162,7 +162,7 @@ inline float exact_hypot(float x, float y) {
 /* 2^x = 2^k · 2^f with k = rint(x) and f = x − k in [−1/2, 1/2] (both exact); 2^f = e^(f ln 2) by
  * its Taylor series to degree 7, whose remainder is below 6e-9 (0.1 ulp), in Horner form with
  * fma; then 2^k by ldexp (exact, or rounded once into the denormals). 0 for x ≤ −150, +∞ for
- * x ≥ 128, NaN for NaN. What Beer–Lambert attenuation needs (kernels/dielectric.cl). */
+ * x ≥ 128, NaN for NaN. What Beer–Lambert attenuation needs (kernels/materials/dielectric.cl). */
 inline float exact_exp2(float x) {
     if (x != x) return x;
     if (x <= -150.0f) return 0.0f;

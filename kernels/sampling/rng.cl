@@ -1,7 +1,7 @@
 /* Counter-based sample generators: every number is a pure function of (seed, pixel, sample
  * index, dimension), with no state carried between launches, so the image does not depend on
  * batching or device split (DESIGN.md "Determinism"). The sampler is chosen at compile time:
- * -D SAMPLER_INDEPENDENT (default), SAMPLER_STRATIFIED or SAMPLER_SOBOL. */
+ * -D SAMPLER_INDEPENDENT, SAMPLER_STRATIFIED or SAMPLER_SOBOL, one file each below. */
 #ifndef MCRT_RNG_CL
 #define MCRT_RNG_CL
 
@@ -107,128 +107,14 @@ inline float2 pixel_2d(const SampleStream* s, uint dim) {
     return (float2)(uint_to_unit_float(h.x), uint_to_unit_float(h.y));
 }
 
+/* The sampler the render was built for, one file each in kernels/sampling/ (the host's table of
+ * variants, host/render/variants.cpp): each defines sampler_1d and sampler_2d. */
 #if defined(SAMPLER_STRATIFIED)
-/* Kensler 2013, "Correlated Multi-Jittered Sampling" (Pixar TM 13-01), permute(): a hashed
- * permutation of [0, l) by cycle walking; p selects the permutation. */
-inline uint kensler_permute(uint i, uint l, uint p) {
-    uint w = l - 1u;
-    w |= w >> 1;
-    w |= w >> 2;
-    w |= w >> 4;
-    w |= w >> 8;
-    w |= w >> 16;
-    do {
-        i ^= p;
-        i *= 0xe170893du;
-        i ^= p >> 16;
-        i ^= (i & w) >> 4;
-        i ^= p >> 8;
-        i *= 0x0929eb3fu;
-        i ^= p >> 23;
-        i ^= (i & w) >> 1;
-        i *= 1u | p >> 27;
-        i *= 0x6935fa69u;
-        i ^= (i & w) >> 11;
-        i *= 0x74dcb303u;
-        i ^= (i & w) >> 2;
-        i *= 0x9e501cc3u;
-        i ^= (i & w) >> 2;
-        i *= 0xc860a3dfu;
-        i &= w;
-        i ^= i >> 5;
-    } while (i >= l);
-    return (i + p) % l;
-}
-
-/* Jittered strata: sample k of the pixel falls in stratum permute(k) of sample_count strata
- * (1D) or of an nx × ny grid (2D, per dimension pair), each pair with its own permutation so
- * that pairs are not correlated; uniform jitter inside the stratum (PBRT 3rd ed. 7.3). */
-inline float sampler_1d(const SampleStream* s, uint dim) {
-    uint stratum = kensler_permute(s->sample, s->sample_count, pixel_dimension_key(s, dim));
-    float jitter = independent_1d(s->pixel, s->index, dim, s->seed);
-    return min(((float)stratum + jitter) / (float)s->sample_count, 0x1.fffffep-1f);
-}
-
-inline float2 sampler_2d(const SampleStream* s, uint dim) {
-    uint nx = (uint)ceil(sqrt((float)s->sample_count));
-    while (nx * nx < s->sample_count) ++nx; /* float sqrt may round down */
-    uint ny = (s->sample_count + nx - 1u) / nx;
-    uint stratum = kensler_permute(s->sample, nx * ny, pixel_dimension_key(s, dim));
-    float2 jitter = independent_2d(s->pixel, s->index, dim, s->seed);
-    float2 v = (float2)(((float)(stratum % nx) + jitter.x) / (float)nx,
-                        ((float)(stratum / nx) + jitter.y) / (float)ny);
-    return min(v, (float2)(0x1.fffffep-1f));
-}
-
+#include "sampler_stratified.cl"
 #elif defined(SAMPLER_SOBOL)
-inline uint reverse_bits(uint x) {
-    x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
-    x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
-    x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
-    x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
-    return (x >> 16) | (x << 16);
-}
-
-/* Burley 2020, "Practical Hash-based Owen Scrambling" (JCGT 9(4)): the Laine–Karras style hash
- * applied to the bit-reversed value is a nested uniform (Owen) scramble. */
-inline uint laine_karras_permutation(uint x, uint seed) {
-    x += seed;
-    x ^= x * 0x6c50b47cu;
-    x ^= x * 0xb82f1e52u;
-    x ^= x * 0xc7afe638u;
-    x ^= x * 0x8d22f6e6u;
-    return x;
-}
-
-inline uint nested_uniform_scramble(uint x, uint seed) {
-    return reverse_bits(laine_karras_permutation(reverse_bits(x), seed));
-}
-
-/* The first two Sobol' dimensions: van der Corput, and the one with direction numbers
- * v_1 = 2^31, v_k = v_{k-1} ^ (v_{k-1} >> 1) (primitive polynomial x + 1), here bit-reversed
- * (v_1 = 1, v_k = v_{k-1} ^ (v_{k-1} << 1)): what the scramble below reverses first. */
-inline uint sobol_dimension_1_reversed(uint index) {
-    uint x = 0u, v = 1u;
-    for (; index != 0u; index >>= 1, v ^= v << 1)
-        if (index & 1u) x ^= v;
-    return x;
-}
-
-/* The three seeds of a pair's scrambles, per (pixel, dimension, replicate): y shuffles the sample
- * index (as pixel_dimension_key), z and w scramble the two coordinates; three words of one hash,
- * not three hashes. */
-inline uint4 sobol_keys(const SampleStream* s, uint dim) {
-    return pcg4d((uint4)(s->pixel, 0xffffffffu, dim, replicate_seed(s)));
-}
-
-/* Owen-scrambled Sobol' (0,2)-sequence per dimension pair, padded by shuffling the sample index
- * with an independent scramble for each pair (Burley 2020, sec. 4). The coordinates are
- * nested_uniform_scramble(reverse_bits(index)) and nested_uniform_scramble(sobol_dimension_1(
- * index)), written without the bit reversals that cancel (reverse_bits is an involution): 3
- * reversals per pair instead of 6, the same bits. */
-inline float2 sampler_2d(const SampleStream* s, uint dim) {
-    uint4 key = sobol_keys(s, dim);
-    uint index = nested_uniform_scramble(s->sample, key.y);
-    uint x = reverse_bits(laine_karras_permutation(index, key.z));
-    uint y = reverse_bits(laine_karras_permutation(sobol_dimension_1_reversed(index), key.w));
-    return (float2)(uint_to_unit_float(x), uint_to_unit_float(y));
-}
-
-inline float sampler_1d(const SampleStream* s, uint dim) {
-    uint4 key = sobol_keys(s, dim);
-    uint index = nested_uniform_scramble(s->sample, key.y);
-    return uint_to_unit_float(reverse_bits(laine_karras_permutation(index, key.z)));
-}
-
+#include "sampler_sobol.cl"
 #elif defined(SAMPLER_INDEPENDENT)
-inline float sampler_1d(const SampleStream* s, uint dim) {
-    return independent_1d(s->pixel, s->index, dim, s->seed);
-}
-
-/* Dimensions dim and dim + 1, from one hash. */
-inline float2 sampler_2d(const SampleStream* s, uint dim) {
-    return independent_2d(s->pixel, s->index, dim, s->seed);
-}
+#include "sampler_independent.cl"
 #else
 #error "no sampler: the host defines one SAMPLER_* (host/render/variants.cpp)"
 #endif

@@ -1,4 +1,4 @@
-/* Test entry points for kernels/exact_math.cl (tests/test_exact_math.cpp): each evaluates a
+/* Test entry points for kernels/core/exact_math.cl (tests/sampling/test_exact_math.cpp): each evaluates a
  * family of functions over an input buffer and writes what they return. Global sizes are 1D;
  * each entry checks its bound. */
 #include "exact_math.cl"

@@ -214,7 +214,7 @@ typedef struct {
 
 /* Node of the light tree (host/render/light_tree.h), 208 bytes: four slots, each a child node
  * or one light, with the bounds of the lights below it for the importance of
- * kernels/light_tree.cl (Conty Estevez & Kulla 2018; pbrt-v4's LightBounds), laid out as one
+ * kernels/lights/light_tree.cl (Conty Estevez & Kulla 2018; pbrt-v4's LightBounds), laid out as one
  * float4 per quantity so that the four importances are one vector computation. nodes[0] is the
  * root. Per slot k (the vectors' component k):
  * x, y, z: centre of the box of the lights' vertices; radius: of the box's bounding sphere about
@@ -255,9 +255,9 @@ typedef struct {
 } LightTreePath;
 
 /* One entry of an alias table (Walker 1977; Vose 1991), 16 bytes, on the 2^-24 grid of the
- * kernels' u (kernels/discrete.cl): bucket i keeps i when its coin, an integer in [0, 2^24), is
- * below threshold, else gives alias; pmf is the probability of i itself, exactly (a whole
- * number of 2^-24 steps, as the host counts them). */
+ * kernels' u (kernels/sampling/discrete.cl): bucket i keeps i when its coin, an integer in
+ * [0, 2^24), is below threshold, else gives alias; pmf is the probability of i itself, exactly
+ * (a whole number of 2^-24 steps, as the host counts them). */
 typedef struct {
     uint threshold;
     uint alias;
@@ -391,7 +391,7 @@ typedef struct {
                         16 × (MCRT_MAX_PATH_DEPTH + 1) vertices fit below 2^15) */
 } ChunkSums;
 
-/* The render kernel's arguments in order (kernels/render.cl); the host binds them all in one
+/* The render kernel's arguments in order (kernels/render/render.cl); the host binds them all in one
  * place (bind_render_arguments, host/render/device_worker.cpp). */
 enum RenderArgument {
     RENDER_ARG_NODES,           /* global const Bvh4Node* */
@@ -400,7 +400,7 @@ enum RenderArgument {
     RENDER_ARG_MATERIALS,       /* global const Material* */
     RENDER_ARG_LIGHTS,          /* global const Light* */
     RENDER_ARG_LIGHT_SELECTION, /* global const uint*: the light selection's own data, built
-                                   only for it (kernels/lights.cl, light_set): power's CDF
+                                   only for it (kernels/lights/lights.cl, light_set): power's CDF
                                    (light_count + 1 floats), alias's table (light_count
                                    AliasEntry), the tree's nodes (light_tree_nodes
                                    LightTreeNode) followed by the lights' LightTreePath;
@@ -424,8 +424,8 @@ enum RenderArgument {
 
 /* Size, alignment and field offsets of every shared struct, listed once: the host checks them
  * with static_assert (below), the device reports its own through the `shared_type_layout`
- * kernel (kernels/render.cl) and a test compares the two. TYPE(T, size, align) opens a struct,
- * FIELD(T, member, offset) follows for each member. */
+ * kernel (kernels/render/render.cl) and a test compares the two. TYPE(T, size, align) opens a
+ * struct, FIELD(T, member, offset) follows for each member. */
 #define MCRT_SHARED_LAYOUT(TYPE, FIELD)                                                          \
     TYPE(BvhNode, 32, 16) FIELD(BvhNode, lo, 0) FIELD(BvhNode, hi, 16)                          \
     TYPE(Bvh4Node, 128, 16) FIELD(Bvh4Node, lo_x, 0) FIELD(Bvh4Node, hi_x, 16)                  \

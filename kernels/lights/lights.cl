@@ -2,29 +2,32 @@
 #ifndef MCRT_LIGHTS_CL
 #define MCRT_LIGHTS_CL
 
+/* What the selection files include, included here first: the host expands each file once, at its
+ * first #include, whether or not an #if around it holds (host/cl/program.cpp). */
 #include "discrete.cl"
 #include "light_tree.cl"
 #include "sampling.cl"
 
-/* The lights and the data of the light selection the render was built for (-D
- * LIGHT_SELECT_UNIFORM, LIGHT_SELECT_POWER, LIGHT_SELECT_ALIAS or LIGHT_SELECT_TREE; the host's
- * table of variants, host/render/variants.cpp). light_cdf (light_count + 1 entries) and alias
- * (light_count entries) follow emitted power; the light tree (light_tree.cl) weighs power by
- * distance and orientation at the shading point. Zero-power lights are never selected. */
-#if !defined(LIGHT_SELECT_UNIFORM) && !defined(LIGHT_SELECT_POWER) && \
-    !defined(LIGHT_SELECT_ALIAS) && !defined(LIGHT_SELECT_TREE)
+/* The light selection the render was built for, one file each in kernels/lights/ (the host's
+ * table of variants, host/render/variants.cpp; its data built by host/lights/): each defines
+ * LightSelectionView (its view of the selection buffer), light_selection_view, select_light_in
+ * and its twin light_selection_pmf. Zero-power lights are never selected. */
+#if defined(LIGHT_SELECT_UNIFORM)
+#include "select_uniform.cl"
+#elif defined(LIGHT_SELECT_POWER)
+#include "select_power.cl"
+#elif defined(LIGHT_SELECT_ALIAS)
+#include "select_alias.cl"
+#elif defined(LIGHT_SELECT_TREE)
+#include "select_tree.cl"
+#else
 #error "no light selection: the host defines one LIGHT_SELECT_* (host/render/variants.cpp)"
 #endif
+
+/* The lights and the data of the light selection. */
 typedef struct {
     global const Light* lights;
-#if defined(LIGHT_SELECT_POWER)
-    global const float* light_cdf;
-#elif defined(LIGHT_SELECT_ALIAS)
-    global const AliasEntry* alias;
-#elif defined(LIGHT_SELECT_TREE)
-    global const LightTreeNode* tree;
-    global const LightTreePath* paths; /* one per light, after the tree's nodes */
-#endif
+    LightSelectionView selection;
     uint light_count; /* area lights: lights[0, light_count) */
 #if defined(MCRT_PUNCTUAL)
     /* The punctual lights (shared_types.h, PunctualGpu), the selection's lights light_count + i:
@@ -44,20 +47,13 @@ inline uint light_selection_count(const LightSet* ls) {
 }
 
 /* The lights and the selection's view of its buffer (shared_types.h, RENDER_ARG_LIGHT_SELECTION:
- * the tree's `tree_nodes` nodes, then the lights' paths). */
+ * for the tree, its `tree_nodes` nodes, then the lights' paths). */
 inline LightSet light_set(global const Light* lights, uint light_count,
                           global const uint* selection, uint tree_nodes) {
     LightSet ls;
     ls.lights = lights;
     ls.light_count = light_count;
-#if defined(LIGHT_SELECT_POWER)
-    ls.light_cdf = (global const float*)selection;
-#elif defined(LIGHT_SELECT_ALIAS)
-    ls.alias = (global const AliasEntry*)selection;
-#elif defined(LIGHT_SELECT_TREE)
-    ls.tree = (global const LightTreeNode*)selection;
-    ls.paths = (global const LightTreePath*)(ls.tree + tree_nodes);
-#endif
+    ls.selection = light_selection_view(selection, tree_nodes);
     return ls;
 }
 
@@ -67,29 +63,12 @@ inline LightSet light_set(global const Light* lights, uint light_count,
  * light_selection_count must be > 0. pmf 0 (the tree only): no light can reach p, nothing was chosen. */
 inline DiscreteSample select_light(const LightSet* ls, float3 p, float3 n, float u,
                                    float u_fine) {
-#if defined(LIGHT_SELECT_UNIFORM)
-    return sample_discrete_uniform(light_selection_count(ls), u, u_fine);
-#elif defined(LIGHT_SELECT_ALIAS)
-    return sample_discrete_alias(ls->alias, light_selection_count(ls), u, u_fine);
-#elif defined(LIGHT_SELECT_TREE)
-    return sample_light_tree(ls->tree, p, n, u, u_fine);
-#else
-    return sample_discrete_cdf(ls->light_cdf, light_selection_count(ls), u, u_fine);
-#endif
+    return select_light_in(&ls->selection, light_selection_count(ls), p, n, u, u_fine);
 }
 
 /* Probability that select_light at (p, n) returns light i. */
 inline float light_pmf(const LightSet* ls, float3 p, float3 n, uint i) {
-#if defined(LIGHT_SELECT_UNIFORM)
-    return 1.0f / (float)light_selection_count(ls);
-#elif defined(LIGHT_SELECT_ALIAS)
-    return discrete_alias_pmf(ls->alias, i);
-#elif defined(LIGHT_SELECT_TREE)
-    LightTreePath path = ls->paths[i];
-    return light_tree_pmf(ls->tree, path.bits, path.length, p, n);
-#else
-    return discrete_cdf_pmf(ls->light_cdf, i);
-#endif
+    return light_selection_pmf(&ls->selection, light_selection_count(ls), p, n, i);
 }
 
 inline bool light_double_sided(const Light* light) {

@@ -1,4 +1,4 @@
-/* Test entry points for the sampling routines (tests/test_sampling.cpp): each runs one family
+/* Test entry points for the sampling routines (tests/sampling/test_sampling.cpp): each runs one family
  * of routines on given or hashed u values and writes what they return. Global sizes are 1D;
  * each entry checks its bound. */
 #include "shared_types.h"

@@ -1,4 +1,4 @@
-/* Test entry points for the glTF BSDF (tests/test_materials.cpp), built with
+/* Test entry points for the glTF BSDF (tests/materials/test_materials.cpp), built with
  * -D MCRT_MATERIALS_GLTF: a surface point on the plane z = 0 (normal +z) seen from direction wo,
  * with the material passed by value (shared_types.h, Material). Global sizes
  * are 1D; each entry checks its bound. */
@@ -67,7 +67,7 @@ kernel void ggx_distribution(float alpha, float4 wo, uint count, global const fl
 }
 
 #if defined(MCRT_TRANSMISSION)
-/* Transmissive builds (-D MCRT_TRANSMISSION, tests/test_glass.cpp): as bsdf_samples and
+/* Transmissive builds (-D MCRT_TRANSMISSION, tests/materials/test_glass.cpp): as bsdf_samples and
  * bsdf_evaluate for a surface point seen from its front (front ≠ 0) or back face; out[k] = (wi,
  * pdf_w), f[k] = (f, cos_theta), lobe[k] the sample's BSDF_LOBE_* bits. */
 kernel void glass_samples(Material material, float4 wo, uint front, uint count, uint seed,

@@ -1,8 +1,8 @@
 // The light tree of --light-select tree: a bounding hierarchy over the emissive triangles whose
 // nodes carry power, a box and a cone of emitting normals, so that the kernels can choose a
-// light in proportion to an importance that depends on the shading point (kernels/light_tree.cl;
-// Conty Estevez & Kulla 2018, "Importance Sampling of Many Lights with Adaptive Tree Splitting";
-// pbrt-v4's BVHLightSampler).
+// light in proportion to an importance that depends on the shading point
+// (kernels/lights/light_tree.cl; Conty Estevez & Kulla 2018, "Importance Sampling of Many Lights
+// with Adaptive Tree Splitting"; pbrt-v4's BVHLightSampler).
 #pragma once
 
 #include <glm/glm.hpp>

@@ -1,4 +1,4 @@
-#include "render/discrete.h"
+#include "lights/discrete.h"
 
 #include <algorithm>
 #include <cmath>
@@ -31,8 +31,8 @@ std::vector<float> build_cdf(const std::vector<double>& weights) {
     double total = checked_total(weights);
     if (total == 0.0) return {0.0f};
     const size_t n = weights.size();
-    // The kernels' u is a multiple of 2^-24 (kernels/rng.cl), so the CDF is built on that grid:
-    // entry i gets units[i] steps of 2^-24, every positive weight at least one, so that every
+    // The kernels' u is a multiple of 2^-24 (kernels/sampling/rng.cl), so the CDF is built on that
+    // grid: entry i gets units[i] steps of 2^-24, every positive weight at least one, so that every
     // light with power is reachable and its pmf, cdf[i+1] − cdf[i] = units[i]·2^-24, is exact
     // in float and is the probability of selecting it (PBRT 3rd ed. 13.3.1 with its rounding
     // made exact). Largest remainders settle the total at 2^24 (Hamilton's apportionment).
@@ -118,7 +118,7 @@ std::vector<gpu::AliasEntry> build_alias_table(const std::vector<double>& weight
         alias[i] = uint32_t(empty ? heaviest : i);
     }
 
-    // On the kernels' grid (kernels/discrete.cl): k in [0, 2^24) falls in bucket b when
+    // On the kernels' grid (kernels/sampling/discrete.cl): k in [0, 2^24) falls in bucket b when
     // b·2^24 ≤ k·n < (b+1)·2^24, i.e. for c_b values of k from ceil(b·2^24/n), whose coins
     // k·n − b·2^24 run from s_b < n in steps of n. A threshold keeping d_b of them keeps i with
     // probability d_b/2^24 and gives alias the other c_b − d_b; d_b = round(prob·c_b), at least
