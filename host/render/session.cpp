@@ -188,7 +188,7 @@ std::unique_ptr<DeviceWorker> RenderSession::make_worker(SceneUploads& uploads, 
     auto kept = upload.selections.find(selection);
     if (kept == upload.selections.end()) {
         DeviceUpload::Selection added;
-        added.buffer = upload_light_selection(device, host_data(), &added.tree_nodes);
+        added.buffer = upload_light_selection(device, host_data(), selection, &added.tree_nodes);
         kept = upload.selections.emplace(selection, added).first;
     }
     write_camera(device, *upload.buffers, data.camera);
