@@ -2,7 +2,7 @@
 
     import mcrt
     ctx = mcrt.Context(device="pocl")
-    scene = ctx.load("scenes/cornell/cornell.gltf")
+    scene = ctx.load("scenes/cornell/CornellBox-Original.gltf")
     r = scene.render(width=64, height=64, spp=16, estimator="mis")
     r.image            # numpy float32 (H, W, 3), a view on the result (no copy)
     r.save("out.exr", png="out.png")
