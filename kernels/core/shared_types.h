@@ -14,8 +14,8 @@
  * work-items, and its vectoriser returns wrong values from any function it does not inline that
  * returns a float3 (four lines show it: docs/ROBUSTNESS.md). With -D MCRT_INTEL_VECTORIZE
  * (MCRT_KERNEL_OPTIONS) every function declared `inline` is inlined, and the vectorised kernels
- * render PoCL's bits; but at 0.17-0.38 of the unvectorised kernels' samples per second on every
- * variant measured (docs/BENCHMARKS.md, "Intel's OpenCL CPU runtime beside PoCL"): each lane
+ * render PoCL's bits; but slower than the unvectorised kernels on every variant measured
+ * (docs/BENCHMARKS.md, "Intel's OpenCL CPU runtime beside PoCL"): each lane
  * fetches its own float4 nodes and triangle packets by gathers. So by default each work-item
  * runs as scalar code there, as on PoCL. render.cl includes this header before any function. */
 #if defined(MCRT_INTEL_CPU) && defined(MCRT_INTEL_VECTORIZE)

@@ -1,8 +1,8 @@
 /* BVH traversal over 4-wide nodes (Bvh4Node): closest hit for camera rays, any hit for shadow
  * rays. One slab test in float4 arithmetic covers a node's four children, one watertight test in
  * float4 arithmetic a leaf's packet of four triangles: PoCL runs each ray as scalar code, so SIMD
- * comes only from explicit vector types (docs/BENCHMARKS.md, "Ray traversal": the node gave up to 1.5×
- * over a BVH2, the packets 1.3–1.4× more on the large scenes). */
+ * comes only from explicit vector types (docs/BENCHMARKS.md, "The traversal's steps, each
+ * measured", has what each of these choices gained). */
 #ifndef MCRT_BVH_TRAVERSE_CL
 #define MCRT_BVH_TRAVERSE_CL
 
@@ -104,7 +104,7 @@ inline float4 bvh4_entry(global const Bvh4Node* node, const BoxRay* b, float t_m
     float4 tf_y = (f[b->near_y ^ 1u] - b->org_y) * b->inv_y;
     float4 tn_z = (f[b->near_z] - b->org_z) * b->inv_z;
     float4 tf_z = (f[b->near_z ^ 1u] - b->org_z) * b->inv_z;
-    /* min/max, not fmin/fmax: these keep NaN semantics on PoCL at four times the cost. */
+    /* min/max, not fmin/fmax: these add a NaN compare and a blend per lane on x86. */
     float4 t_enter = max(max(tn_x, tn_y), max(tn_z, (float4)(0.0f)));
     /* Conservative exit so rounding never culls a box the ray grazes (PBRT 3rd ed. 3.9.2). */
     float4 t_exit = min(min(tf_x, tf_y), tf_z) * (1.0f + 2.0f * MCRT_GAMMA3);
@@ -213,7 +213,7 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
                 int4 at_m = lanes & (tm == (float4)(m));
                 uint mi = pk->index[i] & PACKET_INDEX_MASK;
                 /* Ties (two lanes at m, or m at the held t) are rare: a branch that is almost
-                 * never taken, where the index compares on every packet cost 10-20%. */
+                 * never taken, rather than the index compares on every packet. */
                 if (-(at_m.x + at_m.y + at_m.z + at_m.w) > 1) {
                     uint4 idx = select((uint4)(UINT_MAX),
                                        vload4(0, pk->index) & (uint4)(PACKET_INDEX_MASK),
@@ -250,8 +250,8 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
  * leaves a surface (skip is its triangle, not MCRT_NO_HIT) also beyond δt, the hit's own
  * rounding bound (intersect.cl). Only the winner's δt is computed: a winner within it (a
  * coplanar neighbour of the surface the ray leaves, hit at t ≈ 0 by rounding) is passed over by
- * traversing again beyond its δt. A camera ray starts on no surface and needs no bound (it cost
- * the bench's primary rays 12% on veach-mis). */
+ * traversing again beyond its δt. A camera ray starts on no surface and needs no bound (what it
+ * would cost: docs/BENCHMARKS.md, "Rays leaving surfaces"). */
 inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                            const Ray* r, float t_max, uint skip, const AlphaTest* alpha) {
     float t_min = 0.0f;
