@@ -452,6 +452,11 @@ PYBIND11_MODULE(_mcrt, m) {
                                    std::unique_lock<std::mutex> lock = lock_without_gil(c.mutex);
                                    return c.session ? c.session->environments().reads() : 0;
                                })
+        .def_property_readonly("_environment_uploads",
+                               [](ContextState& c) {
+                                   std::unique_lock<std::mutex> lock = lock_without_gil(c.mutex);
+                                   return c.session ? c.session->environment_uploads() : 0;
+                               })
         .def_property_readonly("devices",
                                [](ContextState& c) {
                                    std::unique_lock<std::mutex> lock = lock_without_gil(c.mutex);

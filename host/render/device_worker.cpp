@@ -59,6 +59,21 @@ void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene,
     CL_CHECK(render.setArg(gpu::RENDER_ARG_SAMPLES, samples));
 }
 
+cl::Buffer upload_environment(const DeviceContext& device, const EnvironmentLight* environment) {
+    const std::vector<float> words =
+        environment ? environment_words(*environment) : std::vector<float>(1, 0.0f);
+    const size_t bytes = words.size() * sizeof(float);
+    if (bytes > device.info.max_allocation)
+        throw RuntimeError("the environment map needs " + std::to_string(bytes) +
+                           " bytes, more than the " + std::to_string(device.info.max_allocation) +
+                           " bytes device '" + device.info.name + "' can allocate at once");
+    cl_int status = CL_SUCCESS;
+    cl::Buffer buffer(device.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes,
+                      const_cast<float*>(words.data()), &status);
+    CL_CHECK_STATUS(status, "clCreateBuffer(environment map)");
+    return buffer;
+}
+
 DeviceWorker::DeviceWorker(const DeviceContext& device, const GpuSceneData& scene,
                            const RenderPlan& plan)
     : device_(device),
@@ -72,7 +87,7 @@ DeviceWorker::DeviceWorker(const DeviceContext& device, const GpuSceneData& scen
 }
 
 DeviceWorker::DeviceWorker(const DeviceContext& device, const GpuSceneBuffers& scene,
-                           const RenderPlan& plan)
+                           const RenderPlan& plan, const cl::Buffer& environment)
     : device_(device),
       settings_(plan.settings),
       fixed_batch_(plan.fixed_batch),
@@ -80,6 +95,7 @@ DeviceWorker::DeviceWorker(const DeviceContext& device, const GpuSceneBuffers& s
       slow_factor_(test_slow_factor(device.info.index)) {
     build(plan);
     buffers_ = std::make_unique<GpuSceneBuffers>(scene);  // handles: the buffers are shared
+    environment_ = environment;
     set_up(plan);
 }
 
@@ -99,11 +115,9 @@ void DeviceWorker::set_up(const RenderPlan& plan) {
     max_samples_ =
         std::min<uint64_t>(uint64_t(1) << 22, device.info.max_allocation / 4 / sizeof(gpu::float4));
     if (fixed_batch_ > 0) max_samples_ = std::max(max_samples_, fixed_batch_);
-    // The environment map, uploaded for each render (a session keeps the scene, not the map).
-    std::vector<float> env_words(1, 0.0f);
+    // The environment map: the one given (a session's), else uploaded for this render.
     if (plan.environment) {
         const EnvironmentLight& env = *plan.environment;
-        env_words = environment_words(env);
         environment_width_ = uint32_t(env.map.width);
         environment_height_ = uint32_t(env.map.height);
         const double turn = double(env.rotate_deg) * (3.14159265358979323846 / 180.0);
@@ -111,17 +125,8 @@ void DeviceWorker::set_up(const RenderPlan& plan) {
         environment_sin_ = float(std::sin(turn));
         environment_pmf_ = float(plan.environment_steps) * 0x1.0p-24f;  // exact: a grid value
     }
-    const size_t env_bytes = env_words.size() * sizeof(float);
-    if (env_bytes > device.info.max_allocation)
-        throw RuntimeError("the environment map needs " + std::to_string(env_bytes) +
-                           " bytes, more than the " + std::to_string(device.info.max_allocation) +
-                           " bytes device '" + device.info.name + "' can allocate at once");
-    {
-        cl_int status = CL_SUCCESS;
-        environment_ = cl::Buffer(device.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                                  env_bytes, env_words.data(), &status);
-        CL_CHECK_STATUS(status, "clCreateBuffer(environment map)");
-    }
+    if (!environment_()) environment_ = upload_environment(device, plan.environment.get());
+    const size_t env_bytes = environment_.getInfo<CL_MEM_SIZE>();
     // Samples and, at 16 samples a chunk, their runs' sums (grown on demand when spp < 16).
     uint64_t needed =
         buffers_->bytes + env_bytes + max_samples_ * sizeof(gpu::float4) +

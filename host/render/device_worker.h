@@ -22,6 +22,10 @@ namespace mcrt {
 void bind_render_arguments(cl::Kernel& render, const GpuSceneBuffers& scene,
                            const cl::Buffer& environment, const cl::Buffer& samples);
 
+// The environment map's texels and CDF on the device (RENDER_ARG_ENVIRONMENT), one float when
+// there is no map; RuntimeError when the device cannot allocate them at once.
+cl::Buffer upload_environment(const DeviceContext& device, const EnvironmentLight* environment);
+
 class DeviceWorker : public RenderWorker {
   public:
     // Builds the program, uploads the scene and allocates the batch buffers; throws RuntimeError
@@ -30,8 +34,10 @@ class DeviceWorker : public RenderWorker {
     // outlive the worker.
     DeviceWorker(const DeviceContext& device, const GpuSceneData& scene, const RenderPlan& plan);
     // The same on a scene already on the device (a session's, render/session.h): `scene` holds
-    // the light selection's buffer of the plan and the camera of the render.
-    DeviceWorker(const DeviceContext& device, const GpuSceneBuffers& scene, const RenderPlan& plan);
+    // the light selection's buffer of the plan and the camera of the render; `environment`, when
+    // not null, is the plan's environment map already on the device (upload_environment).
+    DeviceWorker(const DeviceContext& device, const GpuSceneBuffers& scene, const RenderPlan& plan,
+                 const cl::Buffer& environment = cl::Buffer());
     // Waits for the commands still in flight: they write into this worker's host memory.
     ~DeviceWorker() override;
 

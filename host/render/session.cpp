@@ -148,6 +148,11 @@ RenderSession::RenderSession(const std::vector<DeviceInfo>& devices, const Warni
     }
 }
 
+uint64_t RenderSession::environment_uploads() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return environment_upload_count_;
+}
+
 size_t RenderSession::uploaded_scenes() const {
     std::lock_guard<std::mutex> lock(mutex_);
     return uploads_.size();
@@ -195,7 +200,19 @@ std::unique_ptr<DeviceWorker> RenderSession::make_worker(SceneUploads& uploads, 
     GpuSceneBuffers buffers = *upload.buffers;  // handles, sharing the device's buffers
     buffers.light_selection = kept->second.buffer;
     buffers.light_tree_nodes = kept->second.tree_nodes;
-    return std::make_unique<DeviceWorker>(device, buffers, plan);
+    cl::Buffer environment;
+    if (plan.environment) {
+        EnvironmentUpload& kept_map = environment_uploads_[device.info.index];
+        if (kept_map.light != plan.environment) {
+            kept_map = {};  // the previous map's buffer released before the next is made
+            const Activity activity("uploading the environment map");
+            kept_map.buffer = upload_environment(device, plan.environment.get());
+            kept_map.light = plan.environment;
+            ++environment_upload_count_;
+        }
+        environment = kept_map.buffer;
+    }
+    return std::make_unique<DeviceWorker>(device, buffers, plan, environment);
 }
 
 RenderResult RenderSession::render(const std::shared_ptr<SessionScene>& scene,

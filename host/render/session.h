@@ -130,6 +130,9 @@ class RenderSession {
 
     // Scenes whose buffers are on the devices now (tests: a released scene's are freed).
     size_t uploaded_scenes() const;
+    // Environment maps uploaded to a device so far (tests: a map the devices hold is not
+    // uploaded again).
+    uint64_t environment_uploads() const;
 
   private:
     // One scene on one device: its buffers, with the light selection's buffer of each selection
@@ -158,6 +161,14 @@ class RenderSession {
     EnvironmentCache environments_;
     std::vector<const DeviceContext*> device_list_;
     std::map<uint64_t, SceneUploads> uploads_;  // by SessionScene::id
+    // The environment map of the last render under one, on each device (by device index): a
+    // sweep under one map uploads it once.
+    struct EnvironmentUpload {
+        std::shared_ptr<const EnvironmentLight> light;
+        cl::Buffer buffer;
+    };
+    std::map<int, EnvironmentUpload> environment_uploads_;
+    uint64_t environment_upload_count_ = 0;
     mutable std::mutex mutex_;
 };
 

@@ -169,18 +169,19 @@ def test_environment_map_is_read_once_while_its_file_is_unchanged(tmp_path):
     with mcrt.Context() as ctx:
         scene = ctx.load(plane)
         reads = lambda: ctx._context._environment_reads
+        uploads = lambda: ctx._context._environment_uploads
         write_hdr(env, 16, 8, lambda i, j: (128, 128, 128, 132 if j == 2 else 129))
         first = render_bytes(scene, tmp_path, "first", env=str(env), estimator="mis", **SMALL)
-        assert reads() == 1
+        assert reads() == 1 and uploads() == len(ctx.devices)
         again = render_bytes(scene, tmp_path, "again", env=str(env), estimator="mis", **SMALL)
-        assert reads() == 1
+        assert reads() == 1 and uploads() == len(ctx.devices)  # the devices keep the map
         assert first == again == cli("first")
         stat = env.stat()
         write_hdr(env, 16, 8, lambda i, j: (128, 128, 128, 132 if i == 3 else 129))
         os.utime(env, ns=(stat.st_atime_ns, stat.st_mtime_ns + 1000000000))
         assert env.stat().st_size == stat.st_size
         changed = render_bytes(scene, tmp_path, "changed", env=str(env), estimator="mis", **SMALL)
-        assert reads() == 2
+        assert reads() == 2 and uploads() == 2 * len(ctx.devices)
         assert changed == cli("changed") != first
         # Another scale is another map (the texels are scaled as they are read).
         scene.render(env=str(env), env_scale=2.0, estimator="mis", **SMALL)
