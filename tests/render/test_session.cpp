@@ -1,11 +1,13 @@
 // The render session (render/session.h): a scene loaded once and rendered under several
 // requests gives, request by request, the bytes of a render planned and uploaded afresh
-// (plan_render + render()), and releases a scene's device buffers once nobody holds the scene.
+// (plan_render + render()), and releases a scene's device buffers once nobody holds the scene;
+// the workers it hands to another process's driver (serve) render what fresh workers render.
 #include <catch2/catch.hpp>
 #include <cstring>
 
 #include "common/error.h"
 #include "device_support.h"
+#include "render/device_worker.h"
 #include "render/plan.h"
 #include "render/renderer.h"
 #include "render/session.h"
@@ -93,4 +95,50 @@ TEST_CASE("a session scene refuses a request for other materials than it was loa
     CHECK_THROWS_AS(
         load_session_scene(kCornell, "plastic", LightSelection::Power, SceneSource{}, {}),
         SettingError);
+}
+
+TEST_CASE("the workers a session serves with render an item's sums as a freshly uploaded worker",
+          "[session]") {
+    std::vector<DeviceInfo> devices = enumerate_devices({});
+    REQUIRE(!devices.empty());
+    RenderSession session({devices.front()});
+    const DeviceContext& device = *session.devices().front();
+    auto scene = load_session_scene(kCornell, "gltf", LightSelection::Power, SceneSource{}, {});
+    RenderRequest r = request("mis", "tree", "sobol");
+    r.settings.spp = 2 * MCRT_SAMPLES_PER_CHUNK;  // two chunks a pixel
+    const RenderPlan plan = plan_session_render(*scene, r, {});
+    const PlannedRender planned = plan_render(r, SceneSource{}, {});
+
+    // Two items of the image, as rank 0 hands them out: every pixel's first chunk, then the
+    // second chunk of the image's second half (a worker renders any item in any order).
+    const uint32_t pixels = uint32_t(r.settings.width * r.settings.height);
+    WorkItem first{0, 0, 1, 0, pixels}, second{1, 1, 2, pixels / 2, pixels};
+    auto sums_of = [](RenderWorker& w, const WorkItem& item) {
+        BatchResult b = w.run(item);
+        CHECK(b.item.seq == item.seq);
+        return b.sums;
+    };
+    DeviceWorker fresh(device, planned.scene.gpu, planned.plan);
+    const std::vector<gpu::ChunkSums> want_first = sums_of(fresh, first),
+                                      want_second = sums_of(fresh, second);
+    REQUIRE(!want_first.empty());
+    auto same = [](const std::vector<gpu::ChunkSums>& a, const std::vector<gpu::ChunkSums>& b) {
+        return a.size() == b.size() &&
+               std::memcmp(a.data(), b.data(), a.size() * sizeof(gpu::ChunkSums)) == 0;
+    };
+
+    for (int pass = 0; pass < 2; ++pass) {  // the second on the buffers the first uploaded
+        INFO("pass " << pass);
+        size_t served = 0;
+        session.serve(scene, plan, [&](std::vector<std::unique_ptr<DeviceWorker>>& workers) {
+            served = workers.size();
+            REQUIRE(workers.size() == 1);
+            CHECK(same(sums_of(*workers[0], second), want_second));
+            CHECK(same(sums_of(*workers[0], first), want_first));
+        });
+        CHECK(served == 1);
+        CHECK(session.uploaded_scenes() == 1);
+    }
+    // The session renders afterwards as before.
+    CHECK(same_bytes(session.render(scene, plan).image, fresh_render(device, r).image));
 }
