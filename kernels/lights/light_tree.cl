@@ -100,12 +100,22 @@ inline ulong light_tree_cut(ulong lo, ulong hi, float a, float b, float span) {
     return lo + t;
 }
 
+/* A prefetch hint where the compiler has one (clang's __builtin_prefetch), else nothing. */
+#if defined(__has_builtin)
+#if __has_builtin(__builtin_prefetch)
+#define MCRT_PREFETCH(address) __builtin_prefetch(address)
+#endif
+#endif
+#ifndef MCRT_PREFETCH
+#define MCRT_PREFETCH(address) ((void)(address))
+#endif
+
 /* Starts loading what the walk reads after `node` while its importances are computed: the
  * nodes below its inner slots (the next node is one of them) and the lights of its leaf slots
  * (the one chosen is read next, to sample a point on it). On a tree or a light array larger than
- * the cache these loads are the choice's longest waits. Hints only (clang's
- * __builtin_prefetch): nothing is read; `lights` 0 or a slot's light at or past `light_count`
- * (a punctual light) is not fetched. */
+ * the cache these loads are the choice's longest waits. Hints only (MCRT_PREFETCH): nothing is
+ * read; `lights` 0 or a slot's light at or past `light_count` (a punctual light) is not
+ * fetched. */
 inline void light_tree_prefetch_below(global const LightTreeNode* nodes,
                                       global const LightTreeNode* node,
                                       global const Light* lights, uint light_count) {
@@ -114,11 +124,11 @@ inline void light_tree_prefetch_below(global const LightTreeNode* nodes,
         if ((node->flags & (LIGHT_SLOT_LEAF << slot)) == 0u) {
             global const char* next = (global const char*)(nodes + child);
             for (uint line = 0u; line < sizeof(LightTreeNode); line += 64u)
-                __builtin_prefetch(next + line);
+                MCRT_PREFETCH(next + line);
         } else if (lights != 0 && child < light_count) {
             global const char* light = (global const char*)(lights + child);
             for (uint line = 0u; line < sizeof(Light); line += 64u)
-                __builtin_prefetch(light + line);
+                MCRT_PREFETCH(light + line);
         }
     }
 }
