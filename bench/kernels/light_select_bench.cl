@@ -21,6 +21,6 @@ kernel void light_select_bench(uint method, global const float* cdf, global cons
     DiscreteSample s = method == 0u   ? sample_discrete_cdf(cdf, n, u, u_fine)
                        : method == 1u ? sample_discrete_alias(alias, n, u, u_fine)
                        : method == 2u ? sample_discrete_uniform(n, u, u_fine)
-                                      : sample_light_tree(tree, p[k].xyz, normal[k].xyz, u, u_fine);
+                                      : sample_light_tree(tree, 0, 0u, p[k].xyz, normal[k].xyz, u, u_fine);
     out[g] = s.pmf + (float)s.index * 0x1.0p-60f;
 }

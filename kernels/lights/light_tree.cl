@@ -100,15 +100,50 @@ inline ulong light_tree_cut(ulong lo, ulong hi, float a, float b, float span) {
     return lo + t;
 }
 
+/* A prefetch hint where the compiler has one (clang's __builtin_prefetch), else nothing. */
+#if defined(__has_builtin)
+#if __has_builtin(__builtin_prefetch)
+#define MCRT_PREFETCH(address) __builtin_prefetch(address)
+#endif
+#endif
+#ifndef MCRT_PREFETCH
+#define MCRT_PREFETCH(address) ((void)(address))
+#endif
+
+/* Starts loading what the walk reads after `node` while its importances are computed: the
+ * nodes below its inner slots (the next node is one of them) and the lights of its leaf slots
+ * (the one chosen is read next, to sample a point on it). On a tree or a light array larger than
+ * the cache these loads are the choice's longest waits. Hints only (MCRT_PREFETCH): nothing is
+ * read; `lights` 0 or a slot's light at or past `light_count` (a punctual light) is not
+ * fetched. */
+inline void light_tree_prefetch_below(global const LightTreeNode* nodes,
+                                      global const LightTreeNode* node,
+                                      global const Light* lights, uint light_count) {
+    for (uint slot = 0u; slot < LIGHT_TREE_WIDTH; ++slot) {
+        uint child = node->child[slot];
+        if ((node->flags & (LIGHT_SLOT_LEAF << slot)) == 0u) {
+            global const char* next = (global const char*)(nodes + child);
+            for (uint line = 0u; line < sizeof(LightTreeNode); line += 64u)
+                MCRT_PREFETCH(next + line);
+        } else if (lights != 0 && child < light_count) {
+            global const char* light = (global const char*)(lights + child);
+            for (uint line = 0u; line < sizeof(Light); line += 64u)
+                MCRT_PREFETCH(light + line);
+        }
+    }
+}
+
 /* Chooses a light at (p, n) from u on the 2^-24 grid refined by u_fine (discrete.cl). The
  * number (k + u_fine)·2^-24 is held as a 62-bit integer x in [0, range), range ≤ 2^62; each
  * level cuts the range into the slots' shares (first the two pairs, then within each pair) and
  * keeps the part x falls in, rescaled: the stratification of u carries over as with CDF
  * inversion, and x / range at the leaf is uniform for the point on the light. pmf is the product
  * of the slots' probabilities: the chance of the choice up to float rounding. pmf 0: no light
- * can reach p (index is then meaningless). */
-inline DiscreteSample sample_light_tree(global const LightTreeNode* nodes, float3 p, float3 n,
-                                        float u, float u_fine) {
+ * can reach p (index is then meaningless). lights[0, light_count): the area lights, only
+ * prefetched (light_tree_prefetch_below; 0 where the caller reads none). */
+inline DiscreteSample sample_light_tree(global const LightTreeNode* nodes,
+                                        global const Light* lights, uint light_count, float3 p,
+                                        float3 n, float u, float u_fine) {
     DiscreteSample s;
     s.index = 0u;
     s.pmf = 0.0f;
@@ -118,6 +153,7 @@ inline DiscreteSample sample_light_tree(global const LightTreeNode* nodes, float
     ulong range = 1ul << 62;
     float pmf = 1.0f;
     for (uint depth = 0u; depth < MCRT_LIGHT_TREE_MAX_DEPTH; ++depth) {
+        light_tree_prefetch_below(nodes, node, lights, light_count);
         float4 share;
         if (!light_tree_shares(node, p, n, depth == 0u, &share)) return s;
         float span = (float)(long)range;

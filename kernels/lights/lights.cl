@@ -54,6 +54,10 @@ inline LightSet light_set(global const Light* lights, uint light_count,
     ls.lights = lights;
     ls.light_count = light_count;
     ls.selection = light_selection_view(selection, tree_nodes);
+#if defined(LIGHT_SELECT_TREE)
+    ls.selection.lights = lights; /* for the walk's prefetch of the chosen light */
+    ls.selection.light_count = light_count;
+#endif
     return ls;
 }
 

@@ -10,6 +10,8 @@
 typedef struct {
     global const LightTreeNode* tree;
     global const LightTreePath* paths; /* one per light, after the tree's nodes */
+    global const Light* lights;        /* the area lights, which the walk prefetches */
+    uint light_count;
 } LightSelectionView;
 
 /* The buffer holds the tree's `tree_nodes` nodes, then the lights' paths. */
@@ -17,6 +19,8 @@ inline LightSelectionView light_selection_view(global const uint* selection, uin
     LightSelectionView view;
     view.tree = (global const LightTreeNode*)selection;
     view.paths = (global const LightTreePath*)(view.tree + tree_nodes);
+    view.lights = 0;
+    view.light_count = 0u;
     return view;
 }
 
@@ -24,7 +28,7 @@ inline LightSelectionView light_selection_view(global const uint* selection, uin
  * pmf 0: no light can reach p, nothing was chosen. */
 inline DiscreteSample select_light_in(const LightSelectionView* view, uint count, float3 p,
                                       float3 n, float u, float u_fine) {
-    return sample_light_tree(view->tree, p, n, u, u_fine);
+    return sample_light_tree(view->tree, view->lights, view->light_count, p, n, u, u_fine);
 }
 
 /* Probability that select_light_in at (p, n) returns light i: its stored path walked with the

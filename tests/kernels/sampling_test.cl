@@ -165,7 +165,7 @@ kernel void sample_light_tree_at(global const LightTreeNode* nodes, global const
     float u = stratified != 0u ? ((float)(j % per_point) + 0.5f) / (float)per_point
                                : uint_to_unit_float(h.x);
     float u_fine = uint_to_unit_float(h.y);
-    DiscreteSample s = sample_light_tree(nodes, p[k].xyz, normal[k].xyz, u, u_fine);
+    DiscreteSample s = sample_light_tree(nodes, 0, 0u, p[k].xyz, normal[k].xyz, u, u_fine);
     float twin = s.pmf > 0.0f ? light_tree_pmf(nodes, paths[s.index].bits, paths[s.index].length,
                                                p[k].xyz, normal[k].xyz)
                               : 0.0f;
