@@ -51,7 +51,7 @@ class DeviceTracer {
   public:
     DeviceTracer(const DeviceInfo& info, const Bvh& bvh) : device_(info) {
         program_ = cached_program(device_, "trace.cl", "");
-        nodes_ = upload(bvh.nodes8.data(), bvh.nodes8.size() * sizeof(gpu::Bvh8Node), "BVH nodes");
+        nodes_ = upload(bvh.nodes4.data(), bvh.nodes4.size() * sizeof(gpu::Bvh4Node), "BVH nodes");
         std::vector<gpu::TrianglePacket> one(1);
         const auto& packets = bvh.packets.empty() ? one : bvh.packets;
         packets_ = upload(packets.data(), packets.size() * sizeof(gpu::TrianglePacket),
@@ -283,9 +283,9 @@ int run_bench(const BenchOptions& o, const std::function<void(const std::string&
                 {"device", tracer.info().name},
                 {"triangles", scene.triangle_count()},
                 {"bvh_build_seconds", bvh.stats.build_seconds},
-                {"sah_cost", bvh.stats.sah_cost8},
-                {"bvh_depth", bvh.stats.depth8},
-                {"bvh_nodes", bvh.nodes8.size()},
+                {"sah_cost", bvh.stats.sah_cost4},
+                {"bvh_depth", bvh.stats.depth4},
+                {"bvh_nodes", bvh.nodes4.size()},
                 {"bvh_packets", bvh.stats.packets},
                 {"bytes_per_triangle", bytes_per_triangle},
             };
@@ -315,9 +315,9 @@ int run_bench(const BenchOptions& o, const std::function<void(const std::string&
                                         : "its first",
                 o.width, o.height, o.device, tracer.info().name.c_str());
     std::printf(
-        "mcrt BVH8: built in %.3f s, SAH cost %.2f, depth %d, %zu nodes, %zu packets, %.1f bytes "
+        "mcrt BVH4: built in %.3f s, SAH cost %.2f, depth %d, %zu nodes, %zu packets, %.1f bytes "
         "per triangle\n",
-        bvh.stats.build_seconds, bvh.stats.sah_cost8, bvh.stats.depth8, bvh.nodes8.size(),
+        bvh.stats.build_seconds, bvh.stats.sah_cost4, bvh.stats.depth4, bvh.nodes4.size(),
         bvh.stats.packets, bytes_per_triangle);
 #ifdef MCRT_HAVE_EMBREE
     std::printf("Embree %s: built in %.3f s (default quality), %u threads, single-ray API\n",

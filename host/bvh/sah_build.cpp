@@ -1,6 +1,6 @@
 // Binned SAH BVH build over triangle centroids (Wald 2007, "On fast construction of SAH-based
 // bounding volume hierarchies"; PBRT 3rd ed. 4.3), flattened depth-first with siblings adjacent,
-// then collapsed into the 8-wide tree of bvh8_collapse.cpp.
+// then collapsed into the 4-wide tree of bvh4_collapse.cpp.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -501,15 +501,15 @@ Bvh Builder::build() {
     }
     fill_stats(bvh, depth);
 
-    // The device traverses the 8-wide collapse of this tree, its leaves in packets.
+    // The device traverses the 4-wide collapse of this tree, its leaves in packets.
     const auto collapse_start = std::chrono::steady_clock::now();
-    Bvh8 bvh4 = collapse_to_bvh8(bvh.nodes, traversal_cost_);
-    bvh.nodes8 = std::move(bvh4.nodes);
-    bvh.packets = pack_leaves(bvh.nodes8, bvh.triangles);
-    bvh.stats.depth8 = bvh4.depth;
-    bvh.stats.sah_cost8 = bvh4.sah_cost;
+    Bvh4 bvh4 = collapse_to_bvh4(bvh.nodes, traversal_cost_);
+    bvh.nodes4 = std::move(bvh4.nodes);
+    bvh.packets = pack_leaves(bvh.nodes4, bvh.triangles);
+    bvh.stats.depth4 = bvh4.depth;
+    bvh.stats.sah_cost4 = bvh4.sah_cost;
     bvh.stats.packets = bvh.packets.size();
-    bvh.stats.bytes = bvh.nodes8.size() * sizeof(gpu::Bvh8Node) +
+    bvh.stats.bytes = bvh.nodes4.size() * sizeof(gpu::Bvh4Node) +
                       bvh.packets.size() * (sizeof(gpu::TrianglePacket) +
                                             MCRT_PACKET_WIDTH * sizeof(gpu::TriangleInfo));
     const auto end = std::chrono::steady_clock::now();

@@ -84,12 +84,12 @@ nlohmann::json render_stats_json(const RenderStatsInput& in) {
           {"texel_bytes", texel_bytes(in.scene.scene)},
           {"device_bytes", gpu_scene.textures.size() * sizeof(uint32_t) +
                                gpu_scene.surfaces.size() * sizeof(gpu::TriangleSurface)}}},
-        // The 8-wide tree the kernels traverse; the binary SAH tree it collapses as binary_*.
+        // The 4-wide tree the kernels traverse; the binary SAH tree it collapses as binary_*.
         {"bvh",
-         {{"nodes", bvh.nodes8.size()},
+         {{"nodes", bvh.nodes4.size()},
           {"packets", bvh.stats.packets},
-          {"sah_cost", bvh.stats.sah_cost8},
-          {"depth", bvh.stats.depth8},
+          {"sah_cost", bvh.stats.sah_cost4},
+          {"depth", bvh.stats.depth4},
           {"bytes", bvh.stats.bytes},
           {"binary_nodes", bvh.nodes.size()},
           {"binary_sah_cost", bvh.stats.sah_cost},

@@ -87,21 +87,16 @@ uint32_t environment_pmf_steps(const EnvironmentLight& env, const GpuSceneData& 
     double share = 1.0 / double(n + 1);
     if (selection != LightSelection::Uniform) {
         // The radius of the scene's bounding sphere: half the diagonal of the root's boxes.
-        const gpu::Bvh8Node& root = scene.nodes.front();
-        const gpu::float4* lo[3] = {root.lo_x, root.lo_y, root.lo_z};
-        const gpu::float4* hi[3] = {root.hi_x, root.hi_y, root.hi_z};
-        auto slot = [](const gpu::float4* plane, int k) {
-            const gpu::float4& v = plane[k / 4];
-            return k % 4 == 0 ? v.x : k % 4 == 1 ? v.y : k % 4 == 2 ? v.z : v.w;
-        };
+        const gpu::Bvh4Node& root = scene.nodes.front();
+        const float* lo[3] = {&root.lo_x.x, &root.lo_y.x, &root.lo_z.x};
+        const float* hi[3] = {&root.hi_x.x, &root.hi_y.x, &root.hi_z.x};
         double d2 = 0.0;
         for (int a = 0; a < 3; ++a) {
             double a_lo = INFINITY, a_hi = -INFINITY;
-            for (int k = 0; k < MCRT_BVH_WIDTH; ++k) {
-                const float l = slot(lo[a], k), h = slot(hi[a], k);
-                if (l > h) continue;  // an empty slot's inverted box
-                a_lo = std::min(a_lo, double(l));
-                a_hi = std::max(a_hi, double(h));
+            for (int k = 0; k < 4; ++k) {
+                if (lo[a][k] > hi[a][k]) continue;  // an empty slot's inverted box
+                a_lo = std::min(a_lo, double(lo[a][k]));
+                a_hi = std::max(a_hi, double(hi[a][k]));
             }
             if (a_hi >= a_lo) d2 += (a_hi - a_lo) * (a_hi - a_lo);
         }

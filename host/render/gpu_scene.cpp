@@ -135,7 +135,7 @@ gpu::CameraGpu make_gpu_camera(const Camera& camera, int width, int height) {
 GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& camera, int width,
                             int height, LightSelection selection) {
     GpuSceneData data;
-    data.nodes = bvh.nodes8;
+    data.nodes = bvh.nodes4;
     data.packets = bvh.packets;
     for (const Material& m : scene.materials) {
         gpu::Material g{};

@@ -16,7 +16,7 @@
 namespace mcrt {
 
 struct GpuSceneData {
-    std::vector<gpu::Bvh8Node> nodes;              // 8-wide, as the kernels traverse it
+    std::vector<gpu::Bvh4Node> nodes;              // 4-wide, as the kernels traverse it
     std::vector<gpu::TrianglePacket> packets;      // the leaves' triangles, four per ray test
     std::vector<gpu::TriangleInfo> triangle_info;  // per packet lane: 4 per packet
     std::vector<gpu::Material> materials;

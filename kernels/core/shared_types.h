@@ -69,7 +69,7 @@ inline uint as_uint(float f) {
  * switches to median splits before a tree could grow deeper. */
 #define MCRT_BVH_MAX_DEPTH 60
 
-/* Binary BVH node of the host's SAH build, 32 bytes (the device traverses Bvh8Node). Children
+/* Binary BVH node of the host's SAH build, 32 bytes (the device traverses Bvh4Node). Children
  * of an inner node are adjacent: nodes[first], nodes[first+1].
  * lo.xyz / hi.xyz: bounds. lo.w: `first` (child or triangle index, as uint bits).
  * hi.w: triangle count as uint bits; 0 for an inner node. */
@@ -78,26 +78,23 @@ typedef struct {
     float4 hi;
 } BvhNode;
 
-/* 8-wide BVH node, 256 bytes: the boxes of its eight children in SoA form, so that one slab test
- * in float8 arithmetic covers all eight (Wald, Benthin, Boulos 2008, "Getting rid of packets";
- * Embree's BVH8). Each plane is two float4s, slots 0-3 then 4-7, read as one float8. Slot i is
- *   - an inner child: count[i] == 0, child[i] = index of its Bvh8Node;
+/* 4-wide BVH node, 128 bytes: the boxes of its four children in SoA form, so that one slab test
+ * in float4 arithmetic covers all four (Wald, Benthin, Boulos 2008, "Getting rid of packets";
+ * Embree's BVH4). Slot i is
+ *   - an inner child: count[i] == 0, child[i] = index of its Bvh4Node;
  *   - a leaf: count[i] = number of triangles (> 0), child[i] = index of its first
  *     TrianglePacket; the leaf's triangles fill packets child[i] .. child[i] + ceil(count/4) - 1
  *     lane by lane, in leaf order;
  *   - empty: count[i] == 0, child[i] == 0 and an inverted box (lo = +1e30, hi = -1e30) that the
  *     traversal's sign-selected slab test always rejects (near plane beyond far plane).
- * nodes[0] is the root; an empty scene's root has eight empty slots. */
+ * nodes[0] is the root; an empty scene's root has four empty slots. */
 typedef struct {
-    float4 lo_x[2], hi_x[2]; /* 0, 32: order lo, hi per axis: the slab test picks near/far by index */
-    float4 lo_y[2], hi_y[2]; /* 64, 96 */
-    float4 lo_z[2], hi_z[2]; /* 128, 160 */
-    uint child[8];           /* 192 */
-    uint count[8];           /* 224 */
-} Bvh8Node;
-
-/* Children of a Bvh8Node. */
-#define MCRT_BVH_WIDTH 8
+    float4 lo_x, hi_x; /* 0, 16: order lo, hi per axis: the slab test picks near/far by index */
+    float4 lo_y, hi_y; /* 32, 48 */
+    float4 lo_z, hi_z; /* 64, 80 */
+    uint child[4];     /* 96 */
+    uint count[4];     /* 112 */
+} Bvh4Node;
 
 /* Up to four triangles of one leaf in SoA form, 160 bytes, so that one watertight test in float4
  * arithmetic covers all four (Wald, Benthin, Boulos 2008; Embree's triangle4). v[3k + a] holds
@@ -126,9 +123,9 @@ typedef struct {
     uint light;    /* index of its Light plus one, 0 when it is not a light */
 } TriangleInfo;
 
-/* Longest root-to-leaf path of Bvh8Node (counting inner Bvh8Nodes): every Bvh8Node is an inner
+/* Longest root-to-leaf path of Bvh4Node (counting inner Bvh4Nodes): every Bvh4Node is an inner
  * node of the binary tree, so at most MCRT_BVH_MAX_DEPTH - 1 of them lie on a path. */
-#define MCRT_BVH8_MAX_DEPTH (MCRT_BVH_MAX_DEPTH - 1)
+#define MCRT_BVH4_MAX_DEPTH (MCRT_BVH_MAX_DEPTH - 1)
 
 /* Triangle in BVH leaf order, 64 bytes, on the host (Bvh::triangles; the device reads vertices
  * from TrianglePacket and the rest from TriangleInfo): world-space vertices, counter-clockwise
@@ -397,7 +394,7 @@ typedef struct {
 /* The render kernel's arguments in order (kernels/render/render.cl); the host binds them all in one
  * place (bind_render_arguments, host/render/device_worker.cpp). */
 enum RenderArgument {
-    RENDER_ARG_NODES,           /* global const Bvh8Node* */
+    RENDER_ARG_NODES,           /* global const Bvh4Node* */
     RENDER_ARG_PACKETS,         /* global const TrianglePacket* */
     RENDER_ARG_TRIANGLE_INFO,   /* global const TriangleInfo*: per packet lane */
     RENDER_ARG_MATERIALS,       /* global const Material* */
@@ -431,9 +428,9 @@ enum RenderArgument {
  * struct, FIELD(T, member, offset) follows for each member. */
 #define MCRT_SHARED_LAYOUT(TYPE, FIELD)                                                          \
     TYPE(BvhNode, 32, 16) FIELD(BvhNode, lo, 0) FIELD(BvhNode, hi, 16)                          \
-    TYPE(Bvh8Node, 256, 16) FIELD(Bvh8Node, lo_x, 0) FIELD(Bvh8Node, hi_x, 32)                  \
-    FIELD(Bvh8Node, lo_y, 64) FIELD(Bvh8Node, hi_y, 96) FIELD(Bvh8Node, lo_z, 128)              \
-    FIELD(Bvh8Node, hi_z, 160) FIELD(Bvh8Node, child, 192) FIELD(Bvh8Node, count, 224)          \
+    TYPE(Bvh4Node, 128, 16) FIELD(Bvh4Node, lo_x, 0) FIELD(Bvh4Node, hi_x, 16)                  \
+    FIELD(Bvh4Node, lo_y, 32) FIELD(Bvh4Node, hi_y, 48) FIELD(Bvh4Node, lo_z, 64)               \
+    FIELD(Bvh4Node, hi_z, 80) FIELD(Bvh4Node, child, 96) FIELD(Bvh4Node, count, 112)            \
     TYPE(TrianglePacket, 160, 16) FIELD(TrianglePacket, v, 0) FIELD(TrianglePacket, index, 144) \
     TYPE(TriangleInfo, 8, 4) FIELD(TriangleInfo, material, 0) FIELD(TriangleInfo, light, 4)     \
     TYPE(Triangle, 64, 16) FIELD(Triangle, p0, 0) FIELD(Triangle, p1, 16)                       \

@@ -10,7 +10,7 @@
  * p.pixel_begin + g / p.batch_samples < p.pixel_end (samples of a pixel adjacent) along a path
  * of at most p.max_depth reflections (path.cl) and writes samples[g] = (the radiance's bits, the
  * packed PathRecord). Arguments in the order of RenderArgument. */
-kernel void render(global const Bvh8Node* nodes, global const TrianglePacket* packets,
+kernel void render(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                    global const TriangleInfo* triangle_info, global const Material* materials,
                    global const Light* lights, global const uint* light_selection,
                    global const TriangleSurface* surfaces, global const uint* textures,

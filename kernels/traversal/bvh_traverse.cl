@@ -1,5 +1,5 @@
-/* BVH traversal over 8-wide nodes (Bvh8Node): closest hit for camera rays, any hit for shadow
- * rays. One slab test in float8 arithmetic covers a node's eight children, one watertight test in
+/* BVH traversal over 4-wide nodes (Bvh4Node): closest hit for camera rays, any hit for shadow
+ * rays. One slab test in float4 arithmetic covers a node's four children, one watertight test in
  * float4 arithmetic a leaf's packet of four triangles: PoCL runs each ray as scalar code, so SIMD
  * comes only from explicit vector types (docs/BENCHMARKS.md, "Ray traversal": the node gave up to 1.5×
  * over a BVH2, the packets 1.3–1.4× more on the large scenes). */
@@ -53,11 +53,11 @@ typedef struct {
 #define PACKET_INDEX_MASK 0xffffffffu
 #endif
 
-/* A visited inner node pushes at most 7 of its children (the nearest is visited next), and the
- * stack holds entries of at most MCRT_BVH8_MAX_DEPTH (59) levels: 7 · 59 = 413 entries never
- * overflow. The any-hit traversal pushes up to 8 inner children and pops one at once, but only
+/* A visited inner node pushes at most 3 of its children (the nearest is visited next), and the
+ * stack holds entries of at most MCRT_BVH4_MAX_DEPTH (59) levels: 3 · 59 = 177 entries never
+ * overflow. The any-hit traversal pushes up to 4 inner children and pops one at once, but only
  * at levels above the deepest, so its peak is lower. Pushes are still bounds-checked. */
-#define BVH_STACK_SIZE ((MCRT_BVH_WIDTH - 1) * MCRT_BVH8_MAX_DEPTH)
+#define BVH_STACK_SIZE (3 * MCRT_BVH4_MAX_DEPTH)
 
 /* γ(3) = 3ε / (1 − 3ε), ε = 2^-24 (PBRT 3rd ed. 3.9.1). */
 #define MCRT_GAMMA3 1.7881396e-7f
@@ -69,55 +69,47 @@ typedef struct {
                       MCRT_NO_HIT on a miss */
 } Hit;
 
-/* The ray as the 8-wide slab test reads it: origin and inverse direction splatted, and per axis
- * the index of the node plane holding the near plane (lo when the ray runs toward +, else hi;
+/* The ray as the 4-wide slab test reads it: origin and inverse direction splatted, and per axis
+ * the index of the node field holding the near plane (lo when the ray runs toward +, else hi;
  * the far plane is the other one, index ^ 1). */
 typedef struct {
-    float8 org_x, org_y, org_z;
-    float8 inv_x, inv_y, inv_z;
+    float4 org_x, org_y, org_z;
+    float4 inv_x, inv_y, inv_z;
     uint near_x, near_y, near_z;
 } BoxRay;
 
 inline BoxRay make_box_ray(const Ray* r) {
     BoxRay b;
-    b.org_x = (float8)(r->org.x);
-    b.org_y = (float8)(r->org.y);
-    b.org_z = (float8)(r->org.z);
-    b.inv_x = (float8)(r->inv_dir.x);
-    b.inv_y = (float8)(r->inv_dir.y);
-    b.inv_z = (float8)(r->inv_dir.z);
+    b.org_x = (float4)(r->org.x);
+    b.org_y = (float4)(r->org.y);
+    b.org_z = (float4)(r->org.z);
+    b.inv_x = (float4)(r->inv_dir.x);
+    b.inv_y = (float4)(r->inv_dir.y);
+    b.inv_z = (float4)(r->inv_dir.z);
     b.near_x = r->inv_dir.x < 0.0f ? 1u : 0u;
     b.near_y = r->inv_dir.y < 0.0f ? 3u : 2u;
     b.near_z = r->inv_dir.z < 0.0f ? 5u : 4u;
     return b;
 }
 
-/* Entry distances of the ray into the eight child boxes of a node, MAXFLOAT for a child it does
+/* Entry distances of the ray into the four child boxes of a node, MAXFLOAT for a child it does
  * not enter before t_max. Near and far planes are chosen by the ray's signs, not by min/max of
  * the two: an inverted box (an empty slot) then has its near plane beyond its far one and is
  * always rejected, where min/max would read it as a huge box. */
-inline float8 bvh8_entry(global const Bvh8Node* node, const BoxRay* b, float t_max) {
-    /* Planes of 8 floats: lo_x, hi_x, lo_y, hi_y, lo_z, hi_z. */
-    global const float* f = (global const float*)node;
-    float8 tn_x = (vload8(b->near_x, f) - b->org_x) * b->inv_x;
-    float8 tf_x = (vload8(b->near_x ^ 1u, f) - b->org_x) * b->inv_x;
-    float8 tn_y = (vload8(b->near_y, f) - b->org_y) * b->inv_y;
-    float8 tf_y = (vload8(b->near_y ^ 1u, f) - b->org_y) * b->inv_y;
-    float8 tn_z = (vload8(b->near_z, f) - b->org_z) * b->inv_z;
-    float8 tf_z = (vload8(b->near_z ^ 1u, f) - b->org_z) * b->inv_z;
+inline float4 bvh4_entry(global const Bvh4Node* node, const BoxRay* b, float t_max) {
+    global const float4* f = (global const float4*)node; /* lo_x, hi_x, lo_y, hi_y, lo_z, hi_z */
+    float4 tn_x = (f[b->near_x] - b->org_x) * b->inv_x;
+    float4 tf_x = (f[b->near_x ^ 1u] - b->org_x) * b->inv_x;
+    float4 tn_y = (f[b->near_y] - b->org_y) * b->inv_y;
+    float4 tf_y = (f[b->near_y ^ 1u] - b->org_y) * b->inv_y;
+    float4 tn_z = (f[b->near_z] - b->org_z) * b->inv_z;
+    float4 tf_z = (f[b->near_z ^ 1u] - b->org_z) * b->inv_z;
     /* min/max, not fmin/fmax: these keep NaN semantics on PoCL at four times the cost. */
-    float8 t_enter = max(max(tn_x, tn_y), max(tn_z, (float8)(0.0f)));
+    float4 t_enter = max(max(tn_x, tn_y), max(tn_z, (float4)(0.0f)));
     /* Conservative exit so rounding never culls a box the ray grazes (PBRT 3rd ed. 3.9.2). */
-    float8 t_exit = min(min(tf_x, tf_y), tf_z) * (1.0f + 2.0f * MCRT_GAMMA3);
-    t_exit = min(t_exit, (float8)(t_max));
-    return select((float8)(MAXFLOAT), t_enter, t_enter <= t_exit);
-}
-
-/* The number of lanes set in a vector compare's result (-1 per set lane). */
-inline int set_lanes8(int8 m) {
-    int4 s4 = m.lo + m.hi;
-    int2 s2 = s4.lo + s4.hi;
-    return -(s2.x + s2.y);
+    float4 t_exit = min(min(tf_x, tf_y), tf_z) * (1.0f + 2.0f * MCRT_GAMMA3);
+    t_exit = min(t_exit, (float4)(t_max));
+    return select((float4)(MAXFLOAT), t_enter, t_enter <= t_exit);
 }
 
 /* The packet and lane mask of the triangle a ray leaves (a packet lane, 4 · packet + lane, or
@@ -144,7 +136,7 @@ inline int4 skipped_lanes(const SkipLane* s, uint packet) {
  * stack with their entry distances and are skipped once a nearer hit is found. An empty scene's
  * root has only empty slots, so no ray enters it. */
 inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
-    global const Bvh8Node* nodes, global const TrianglePacket* packets, const Ray* r, float t_min,
+    global const Bvh4Node* nodes, global const TrianglePacket* packets, const Ray* r, float t_min,
     float t_max, uint skip, const AlphaTest* alpha) {
     Hit hit;
     hit.t = t_max;
@@ -159,53 +151,41 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
     uint stack_ref[BVH_STACK_SIZE + 1], stack_count[BVH_STACK_SIZE + 1];
     float stack_t[BVH_STACK_SIZE + 1];
     int sp = 0;
-    /* The current child: a Bvh8Node index when count is 0, else a leaf's first packet. */
+    /* The current child: a Bvh4Node index when count is 0, else a leaf's first packet. */
     uint ref = 0u, count = 0u;
     for (;;) {
         if (count == 0u) {
-            global const Bvh8Node* node = nodes + ref;
-            float8 t8 = bvh8_entry(node, &b, hit.t);
-            int8 entered = t8 != (float8)(MAXFLOAT);
-            /* Children are visited nearest first, a later slot first among equals. A child's
-             * visit rank is the number of entered children before it in that order, found
-             * by compares against the rotated distances (a sorting network without
-             * branches or private arrays: the insertion sort it replaces mispredicted on
-             * every node, docs/BENCHMARKS.md, "Kernel changes measured"). Non-entered children are at
-             * MAXFLOAT, after every entered one. Slot j = i + k (mod 8) is before slot i at equal
-             * distance when j > i, i.e. for i < 8 - k. */
-            int8 rank = (t8.s12345670 < t8) | ((t8.s12345670 == t8) & (int8)(-1, -1, -1, -1, -1, -1, -1, 0));
-            rank += (t8.s23456701 < t8) | ((t8.s23456701 == t8) & (int8)(-1, -1, -1, -1, -1, -1, 0, 0));
-            rank += (t8.s34567012 < t8) | ((t8.s34567012 == t8) & (int8)(-1, -1, -1, -1, -1, 0, 0, 0));
-            rank += (t8.s45670123 < t8) | ((t8.s45670123 == t8) & (int8)(-1, -1, -1, -1, 0, 0, 0, 0));
-            rank += (t8.s56701234 < t8) | ((t8.s56701234 == t8) & (int8)(-1, -1, -1, 0, 0, 0, 0, 0));
-            rank += (t8.s67012345 < t8) | ((t8.s67012345 == t8) & (int8)(-1, -1, 0, 0, 0, 0, 0, 0));
-            rank += (t8.s70123456 < t8) | ((t8.s70123456 == t8) & (int8)(-1, 0, 0, 0, 0, 0, 0, 0));
-            rank = -rank;
-            int n = set_lanes8(entered);
-            if (n > 0) {
+            global const Bvh4Node* node = nodes + ref;
+            float4 t4 = bvh4_entry(node, &b, hit.t);
+            int4 entered = t4 != (float4)(MAXFLOAT);
+            if (any(entered)) {
+                /* Children are visited nearest first, a later slot first among equals. A child's
+                 * visit rank is the number of entered children before it in that order, found
+                 * by compares against the rotated distances (a sorting network without
+                 * branches or private arrays: the insertion sort it replaces mispredicted on
+                 * every node, docs/BENCHMARKS.md, "Kernel changes measured"). Non-entered children are at
+                 * MAXFLOAT, after every entered one. */
+                float4 r1 = t4.yzwx, r2 = t4.zwxy, r3 = t4.wxyz;
+                int4 before1 = (r1 < t4) | ((r1 == t4) & (int4)(-1, -1, -1, 0));
+                int4 before2 = (r2 < t4) | ((r2 == t4) & (int4)(-1, -1, 0, 0));
+                int4 before3 = (r3 < t4) | ((r3 == t4) & (int4)(-1, 0, 0, 0));
+                int4 rank = -(before1 + before2 + before3);
+                int n = -(entered.x + entered.y + entered.z + entered.w);
                 /* Rank 0 is visited next; rank k > 0 goes to stack entry sp + n - 1 - k, so
                  * that the stack pops ranks 1, 2, ... in turn. Children that are not pushed
                  * (not entered, rank 0, or beyond a full stack) write the spare entry. */
-                int8 pos = (int8)(sp + n - 1) - rank;
-                pos = select((int8)(BVH_STACK_SIZE), pos,
-                             entered & (rank > (int8)(0)) & (pos < (int8)(BVH_STACK_SIZE)));
-                uint8 child = vload8(0, node->child), cnt = vload8(0, node->count);
-                stack_ref[pos.s0] = child.s0, stack_count[pos.s0] = cnt.s0, stack_t[pos.s0] = t8.s0;
-                stack_ref[pos.s1] = child.s1, stack_count[pos.s1] = cnt.s1, stack_t[pos.s1] = t8.s1;
-                stack_ref[pos.s2] = child.s2, stack_count[pos.s2] = cnt.s2, stack_t[pos.s2] = t8.s2;
-                stack_ref[pos.s3] = child.s3, stack_count[pos.s3] = cnt.s3, stack_t[pos.s3] = t8.s3;
-                stack_ref[pos.s4] = child.s4, stack_count[pos.s4] = cnt.s4, stack_t[pos.s4] = t8.s4;
-                stack_ref[pos.s5] = child.s5, stack_count[pos.s5] = cnt.s5, stack_t[pos.s5] = t8.s5;
-                stack_ref[pos.s6] = child.s6, stack_count[pos.s6] = cnt.s6, stack_t[pos.s6] = t8.s6;
-                stack_ref[pos.s7] = child.s7, stack_count[pos.s7] = cnt.s7, stack_t[pos.s7] = t8.s7;
+                int4 pos = (int4)(sp + n - 1) - rank;
+                pos = select((int4)(BVH_STACK_SIZE), pos,
+                             entered & (rank > 0) & (pos < (int4)(BVH_STACK_SIZE)));
+                uint4 child = vload4(0, node->child), cnt = vload4(0, node->count);
+                stack_ref[pos.x] = child.x, stack_count[pos.x] = cnt.x, stack_t[pos.x] = t4.x;
+                stack_ref[pos.y] = child.y, stack_count[pos.y] = cnt.y, stack_t[pos.y] = t4.y;
+                stack_ref[pos.z] = child.z, stack_count[pos.z] = cnt.z, stack_t[pos.z] = t4.z;
+                stack_ref[pos.w] = child.w, stack_count[pos.w] = cnt.w, stack_t[pos.w] = t4.w;
                 sp = min(sp + n - 1, BVH_STACK_SIZE);
-                /* The rank-0 child, the only lane of `first`, taken by an or over the lanes. */
-                uint8 first = as_uint8(entered & (rank == (int8)(0)));
-                uint8 c8 = child & first, n8 = cnt & first;
-                uint4 c4 = c8.lo | c8.hi, n4 = n8.lo | n8.hi;
-                uint2 c2 = c4.lo | c4.hi, n2 = n4.lo | n4.hi;
-                ref = c2.x | c2.y;
-                count = n2.x | n2.y;
+                int4 first = entered & (rank == 0);
+                ref = first.x ? child.x : first.y ? child.y : first.z ? child.z : child.w;
+                count = first.x ? cnt.x : first.y ? cnt.y : first.z ? cnt.z : cnt.w;
                 continue;
             }
         } else {
@@ -272,7 +252,7 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
  * coplanar neighbour of the surface the ray leaves, hit at t ≈ 0 by rounding) is passed over by
  * traversing again beyond its δt. A camera ray starts on no surface and needs no bound (it cost
  * the bench's primary rays 12% on veach-mis). */
-inline Hit bvh_closest_hit(global const Bvh8Node* nodes, global const TrianglePacket* packets,
+inline Hit bvh_closest_hit(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                            const Ray* r, float t_max, uint skip, const AlphaTest* alpha) {
     float t_min = 0.0f;
     for (;;) {
@@ -294,7 +274,7 @@ inline Hit bvh_closest_hit(global const Bvh8Node* nodes, global const TrianglePa
  * bench's shadow rays this visited 6.7 nodes per ray in Sponza against 9.7 in slot order and 9.0
  * nearest first, but 8.3 against 5.5 in the modern hall (docs/BENCHMARKS.md, "Ray traversal"). No order
  * wins everywhere; this one gave the best worst-case ratio to Embree over the bench scenes. */
-inline bool bvh_any_hit(global const Bvh8Node* nodes, global const TrianglePacket* packets,
+inline bool bvh_any_hit(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                         const Ray* r, float t_max, uint skip, const AlphaTest* alpha) {
     BoxRay b = make_box_ray(r);
     PacketRay q = make_packet_ray(r);
@@ -303,10 +283,10 @@ inline bool bvh_any_hit(global const Bvh8Node* nodes, global const TrianglePacke
     int sp = 0;
     uint ref = 0u;
     for (;;) {
-        global const Bvh8Node* node = nodes + ref;
-        float t_in[MCRT_BVH_WIDTH];
-        vstore8(bvh8_entry(node, &b, t_max), 0, t_in);
-        for (int s = MCRT_BVH_WIDTH - 1; s >= 0; --s) {
+        global const Bvh4Node* node = nodes + ref;
+        float4 t4 = bvh4_entry(node, &b, t_max);
+        float t_in[4] = {t4.x, t4.y, t4.z, t4.w};
+        for (int s = 3; s >= 0; --s) {
             if (t_in[s] == MAXFLOAT) continue;
             uint child = node->child[s], count = node->count[s];
             if (count == 0u) {

@@ -24,7 +24,7 @@ typedef struct {
 typedef struct PathContinuation PathContinuation; /* api.cl */
 
 typedef struct {
-    global const Bvh8Node* nodes;
+    global const Bvh4Node* nodes;
     global const TrianglePacket* packets;     /* the leaves' triangles, for ray queries */
     global const TriangleInfo* triangle_info; /* per packet lane: material, light */
     global const Material* materials;

@@ -5,7 +5,7 @@
 
 /* Closest hit of ray g: origins[g].xyz, directions[g].xyz, t_max in origins[g].w. Writes
  * hits[g] = (t, b1, b2, leaf-order triangle index as uint bits; MCRT_NO_HIT on a miss). */
-kernel void trace_closest(global const Bvh8Node* nodes, global const TrianglePacket* packets,
+kernel void trace_closest(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                           global const float4* origins, global const float4* directions,
                           uint ray_count, global float4* hits) {
     size_t g = get_global_id(0);
@@ -20,7 +20,7 @@ kernel void trace_closest(global const Bvh8Node* nodes, global const TrianglePac
 }
 
 /* Occlusion of ray g in (0, t_max): occluded[g] = 1 if anything blocks it, else 0. */
-kernel void trace_any(global const Bvh8Node* nodes, global const TrianglePacket* packets,
+kernel void trace_any(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                       global const float4* origins, global const float4* directions,
                       uint ray_count, global uint* occluded) {
     size_t g = get_global_id(0);

@@ -1,4 +1,4 @@
-// Binned SAH BVH build and its 8-wide collapse: structure of both flat layouts, SAH costs, and
+// Binned SAH BVH build and its 4-wide collapse: structure of both flat layouts, SAH costs, and
 // closest hits of reference CPU traversals against brute force (as tinybvh validates each layout
 // against a reference tracer).
 #include <algorithm>
@@ -169,32 +169,29 @@ double sah_cost(const Bvh& bvh, float traversal_cost) {
 
 float lane(const gpu::float4& v, int i) { return i == 0 ? v.x : i == 1 ? v.y : i == 2 ? v.z : v.w; }
 
-// Slot s of a node plane (two float4s: slots 0-3, 4-7).
-float lane(const gpu::float4 (&v)[2], int s) { return lane(v[s / 4], s % 4); }
-
-// Box of slot s of an 8-wide node.
-Box slot_box(const gpu::Bvh8Node& n, int s) {
+// Box of slot s of a 4-wide node.
+Box slot_box(const gpu::Bvh4Node& n, int s) {
     Box b;
     b.lo = {lane(n.lo_x, s), lane(n.lo_y, s), lane(n.lo_z, s)};
     b.hi = {lane(n.hi_x, s), lane(n.hi_y, s), lane(n.hi_z, s)};
     return b;
 }
 
-bool is_empty_slot(const gpu::Bvh8Node& n, int s) {
+bool is_empty_slot(const gpu::Bvh4Node& n, int s) {
     const Box b = slot_box(n, s);
     return n.count[s] == 0 && n.child[s] == 0 && b.lo == glm::vec3(1e30f) &&
            b.hi == glm::vec3(-1e30f);
 }
 
-// Every invariant of the 8-wide tree the kernels traverse: each node reached once from the
+// Every invariant of the 4-wide tree the kernels traverse: each node reached once from the
 // root, each triangle in exactly one leaf, the leaves those of the binary tree, every slot box
 // tight around its subtree, empty slots inverted, the depth within the traversal stack's bound.
-void validate8(const Bvh& bvh, const BvhBuildOptions& options) {
+void validate4(const Bvh& bvh, const BvhBuildOptions& options) {
     const size_t n = bvh.triangles.size();
-    REQUIRE(!bvh.nodes8.empty());
-    std::vector<int> reached(bvh.nodes8.size(), 0), covered(n, 0),
+    REQUIRE(!bvh.nodes4.empty());
+    std::vector<int> reached(bvh.nodes4.size(), 0), covered(n, 0),
         packet_uses(bvh.packets.size(), 0);
-    std::vector<std::pair<uint32_t, uint32_t>> leaves8, leaves2;
+    std::vector<std::pair<uint32_t, uint32_t>> leaves4, leaves2;
     size_t problems = 0, infinite = 0, lonely = 0;
     int depth = 0;
     double cost = 0.0, root_area = 0.0;
@@ -211,10 +208,10 @@ void validate8(const Bvh& bvh, const BvhBuildOptions& options) {
         stack.pop_back();
         if (++reached[item.node] > 1) continue;
         depth = std::max(depth, item.level);
-        const gpu::Bvh8Node& node = bvh.nodes8[item.node];
+        const gpu::Bvh4Node& node = bvh.nodes4[item.node];
         Box u;
         int used = 0;
-        for (int s = 0; s < MCRT_BVH_WIDTH; ++s) {
+        for (int s = 0; s < 4; ++s) {
             const Box b = slot_box(node, s);
             for (int k = 0; k < 3; ++k)
                 infinite += !std::isfinite(b.lo[k]) + !std::isfinite(b.hi[k]);
@@ -223,7 +220,7 @@ void validate8(const Bvh& bvh, const BvhBuildOptions& options) {
             if (!glm::all(glm::lessThanEqual(b.lo, b.hi))) ++problems;
             u.grow(b.lo), u.grow(b.hi);
             if (node.count[s] == 0) {
-                if (node.child[s] <= item.node || node.child[s] >= bvh.nodes8.size()) {
+                if (node.child[s] <= item.node || node.child[s] >= bvh.nodes4.size()) {
                     ++problems;
                     continue;
                 }
@@ -261,7 +258,7 @@ void validate8(const Bvh& bvh, const BvhBuildOptions& options) {
                                     lane(p.v[3 * v + 2], int(i)) != q[v]->z;
                 }
             }
-            leaves8.push_back({first, count});
+            leaves4.push_back({first, count});
             Box tight;
             for (uint32_t i = first; i < first + count; ++i) {
                 ++covered[i];
@@ -277,32 +274,32 @@ void validate8(const Bvh& bvh, const BvhBuildOptions& options) {
         // SAH cost (PBRT 4.3.2): a node visit costs traversal_cost, a leaf its packets.
         auto weight = [&](const Box& b) { return root_area > 0 ? b.area() / root_area : 1.0; };
         if (used > 0) cost += options.traversal_cost * weight(u);
-        for (int s = 0; s < MCRT_BVH_WIDTH; ++s)
+        for (int s = 0; s < 4; ++s)
             if (node.count[s] > 0) cost += packets_for(node.count[s]) * weight(slot_box(node, s));
     }
     for (const gpu::BvhNode& node : bvh.nodes)
         if (node_count(node) > 0) leaves2.push_back({node_first(node), node_count(node)});
-    std::sort(leaves8.begin(), leaves8.end());
+    std::sort(leaves4.begin(), leaves4.end());
     std::sort(leaves2.begin(), leaves2.end());
     CHECK(problems == 0);
     CHECK(lonely == 0);
     CHECK(infinite == 0);
-    CHECK(leaves8 == leaves2);
-    CHECK(std::count(reached.begin(), reached.end(), 1) == std::ptrdiff_t(bvh.nodes8.size()));
+    CHECK(leaves4 == leaves2);
+    CHECK(std::count(reached.begin(), reached.end(), 1) == std::ptrdiff_t(bvh.nodes4.size()));
     CHECK(std::count(covered.begin(), covered.end(), 1) == std::ptrdiff_t(n));
     CHECK(std::count(packet_uses.begin(), packet_uses.end(), 1) ==
           std::ptrdiff_t(bvh.packets.size()));
     CHECK(bvh.stats.packets == bvh.packets.size());
-    CHECK(depth == bvh.stats.depth8);
-    CHECK(depth <= kMaxBvh8Depth);
+    CHECK(depth == bvh.stats.depth4);
+    CHECK(depth <= kMaxBvh4Depth);
     CHECK(depth <= std::max(1, bvh.stats.depth - 1));
-    CHECK(bvh.stats.sah_cost8 == Approx(cost).epsilon(1e-6));
+    CHECK(bvh.stats.sah_cost4 == Approx(cost).epsilon(1e-6));
     CHECK(bvh.stats.bytes ==
-          bvh.nodes8.size() * sizeof(gpu::Bvh8Node) +
+          bvh.nodes4.size() * sizeof(gpu::Bvh4Node) +
               bvh.packets.size() * (sizeof(gpu::TrianglePacket) + 4 * sizeof(gpu::TriangleInfo)));
     if (n == 0) {
-        for (int s = 0; s < MCRT_BVH_WIDTH; ++s) CHECK(is_empty_slot(bvh.nodes8[0], s));
-        CHECK(bvh.stats.sah_cost8 == 0.0);
+        for (int s = 0; s < 4; ++s) CHECK(is_empty_slot(bvh.nodes4[0], s));
+        CHECK(bvh.stats.sah_cost4 == 0.0);
     }
 }
 
@@ -389,7 +386,7 @@ void validate(const Scene& scene, const Bvh& bvh, const BvhBuildOptions& options
         for (float f : {node.lo.x, node.lo.y, node.lo.z, node.hi.x, node.hi.y, node.hi.z})
             infinite += !std::isfinite(f);
     CHECK(infinite == 0);
-    validate8(bvh, options);
+    validate4(bvh, options);
 }
 
 struct Ray {
@@ -465,17 +462,17 @@ Hit traverse(const Bvh& bvh, const Ray& ray, bool& overflow) {
     return h;
 }
 
-// Reference traversal of the 8-wide tree as the kernels test it: near and far planes chosen by
+// Reference traversal of the 4-wide tree as the kernels test it: near and far planes chosen by
 // the ray's signs (so that inverted empty slots are rejected), exit scaled by 1 + 2γ₃.
-Hit traverse8(const Bvh& bvh, const Ray& ray, bool& overflow) {
+Hit traverse4(const Bvh& bvh, const Ray& ray, bool& overflow) {
     const float gamma3 = 3 * 0x1p-24f / (1 - 3 * 0x1p-24f);
     const glm::vec3 inv_d = 1.0f / ray.d;
     Hit h;
     std::vector<uint32_t> stack{0u};
     while (!stack.empty()) {
-        const gpu::Bvh8Node& node = bvh.nodes8[stack.back()];
+        const gpu::Bvh4Node& node = bvh.nodes4[stack.back()];
         stack.pop_back();
-        for (int s = 0; s < MCRT_BVH_WIDTH; ++s) {
+        for (int s = 0; s < 4; ++s) {
             const Box b = slot_box(node, s);
             float t_near = 0.0f, t_far = h.t;
             for (int k = 0; k < 3; ++k) {
@@ -499,7 +496,7 @@ Hit traverse8(const Bvh& bvh, const Ray& ray, bool& overflow) {
             }
         }
         // Unordered, so bounded by 4 per level rather than the kernels' 3.
-        if (stack.size() > size_t(4 * kMaxBvh8Depth)) {
+        if (stack.size() > size_t(4 * kMaxBvh4Depth)) {
             overflow = true;
             return h;
         }
@@ -528,7 +525,7 @@ void check_rays(const Scene& scene, const Bvh& bvh, int rays, uint32_t seed) {
         if (glm::length(ray.d) == 0.0f) ray.d = glm::vec3(0.3f, 0.5f, 0.8f);
         ray.d = glm::normalize(ray.d);
         Hit want = brute_force(scene, ray), got = traverse(bvh, ray, overflow),
-            got8 = traverse8(bvh, ray, overflow);
+            got4 = traverse4(bvh, ray, overflow);
         hits += want.triangle >= 0;
         // Same closest t; a different triangle only when it ties at exactly that t.
         if (want.triangle != got.triangle && want.t != got.t) {
@@ -537,11 +534,11 @@ void check_rays(const Scene& scene, const Bvh& bvh, int rays, uint32_t seed) {
                                      << want.triangle << ", BVH t " << got.t << " triangle "
                                      << got.triangle);
         }
-        if (want.triangle != got8.triangle && want.t != got8.t) {
+        if (want.triangle != got4.triangle && want.t != got4.t) {
             if (mismatches++ == 0)
                 UNSCOPED_INFO("ray " << r << ": brute force t " << want.t << " triangle "
-                                     << want.triangle << ", BVH8 t " << got8.t << " triangle "
-                                     << got8.triangle);
+                                     << want.triangle << ", BVH4 t " << got4.t << " triangle "
+                                     << got4.triangle);
         }
     }
     CHECK(mismatches == 0);
@@ -620,12 +617,12 @@ TEST_CASE("BVH of a single triangle is one leaf", "[bvh]") {
     CHECK(node_count(bvh.nodes[0]) == 1);
     CHECK(bvh.stats.depth == 1);
     CHECK(bvh.stats.sah_cost == Approx(1.0));
-    // The 8-wide root holds the leaf in slot 0 and seven empty slots.
-    REQUIRE(bvh.nodes8.size() == 1);
-    CHECK(bvh.nodes8[0].count[0] == 1);
-    CHECK(bvh.nodes8[0].child[0] == 0);
-    for (int s = 1; s < MCRT_BVH_WIDTH; ++s) CHECK(is_empty_slot(bvh.nodes8[0], s));
-    CHECK(bvh.stats.depth8 == 1);
+    // The 4-wide root holds the leaf in slot 0 and three empty slots.
+    REQUIRE(bvh.nodes4.size() == 1);
+    CHECK(bvh.nodes4[0].count[0] == 1);
+    CHECK(bvh.nodes4[0].child[0] == 0);
+    for (int s = 1; s < 4; ++s) CHECK(is_empty_slot(bvh.nodes4[0], s));
+    CHECK(bvh.stats.depth4 == 1);
     check_rays(scene, bvh, 10000, 7);
 }
 
@@ -672,10 +669,10 @@ TEST_CASE("BVH depth stays within kMaxBvhDepth on a pathological scene", "[bvh]"
         INFO("max_leaf_size " << max_leaf);
         validate(scene, bvh, options);
         std::cout << "log-uniform scatter, 10000 triangles, max_leaf_size " << max_leaf
-                  << ": depth " << bvh.stats.depth << " (limit " << kMaxBvhDepth << "), 8-wide "
-                  << bvh.stats.depth8 << " (limit " << kMaxBvh8Depth << ")\n";
+                  << ": depth " << bvh.stats.depth << " (limit " << kMaxBvhDepth << "), 4-wide "
+                  << bvh.stats.depth4 << " (limit " << kMaxBvh4Depth << ")\n";
         CHECK(bvh.stats.depth <= kMaxBvhDepth);
-        CHECK(bvh.stats.depth8 <= kMaxBvh8Depth);
+        CHECK(bvh.stats.depth4 <= kMaxBvh4Depth);
     }
 }
 
@@ -689,9 +686,9 @@ TEST_CASE("BVH of a scene large enough for a multithreaded build is traced exact
     REQUIRE(again.nodes.size() == bvh.nodes.size());
     CHECK(std::memcmp(again.nodes.data(), bvh.nodes.data(),
                       bvh.nodes.size() * sizeof(gpu::BvhNode)) == 0);
-    REQUIRE(again.nodes8.size() == bvh.nodes8.size());
-    CHECK(std::memcmp(again.nodes8.data(), bvh.nodes8.data(),
-                      bvh.nodes8.size() * sizeof(gpu::Bvh8Node)) == 0);
+    REQUIRE(again.nodes4.size() == bvh.nodes4.size());
+    CHECK(std::memcmp(again.nodes4.data(), bvh.nodes4.data(),
+                      bvh.nodes4.size() * sizeof(gpu::Bvh4Node)) == 0);
 }
 
 TEST_CASE("BVH build is deterministic", "[bvh]") {
@@ -725,9 +722,9 @@ TEST_CASE("BVH build of a million triangles completes", "[bvh][large]") {
     std::cout << "1M synthetic triangles (noisy sphere + soup): build " << bvh.stats.build_seconds
               << " s, " << scene.triangle_count() / bvh.stats.build_seconds / 1e6
               << " M triangles/s, SAH cost " << bvh.stats.sah_cost << ", depth " << bvh.stats.depth
-              << ", " << bvh.nodes.size() << " nodes; 8-wide: collapse "
-              << bvh.stats.collapse_seconds << " s, SAH cost " << bvh.stats.sah_cost8 << ", depth "
-              << bvh.stats.depth8 << ", " << bvh.nodes8.size() << " nodes, "
+              << ", " << bvh.nodes.size() << " nodes; 4-wide: collapse "
+              << bvh.stats.collapse_seconds << " s, SAH cost " << bvh.stats.sah_cost4 << ", depth "
+              << bvh.stats.depth4 << ", " << bvh.nodes4.size() << " nodes, "
               << bvh.stats.bytes / 1048576.0 << " MiB on the device\n";
     validate(scene, bvh, options);
 }

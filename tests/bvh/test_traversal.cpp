@@ -1,4 +1,4 @@
-// Device BVH traversal of the 8-wide tree (closest hit, any hit) against a brute-force reference
+// Device BVH traversal of the 4-wide tree (closest hit, any hit) against a brute-force reference
 // in double precision on the same rays, a deep tree, and the watertightness of the ray–triangle
 // test.
 #include <catch2/catch.hpp>
@@ -39,7 +39,7 @@ struct Tracer {
     std::vector<Out> run(const char* entry, const Bvh& bvh, const RaySet& rays) {
         cl::Kernel k = make_kernel(program, entry);
         std::vector<Out> out(rays.origins.size());
-        cl::Buffer nodes = buffer(bvh.nodes8),
+        cl::Buffer nodes = buffer(bvh.nodes4),
                    packets = buffer(bvh.packets.empty() ? std::vector<gpu::TrianglePacket>(1)
                                                         : bvh.packets);
         cl::Buffer o = buffer(rays.origins), d = buffer(rays.directions), result = buffer(out);
@@ -193,12 +193,12 @@ TEST_CASE("no ray escapes a closed mesh through its edges or vertices (watertigh
     CHECK(misses == 0);
 }
 
-TEST_CASE("the device sees Bvh8Node with the host's size", "[traversal]") {
+TEST_CASE("the device sees Bvh4Node with the host's size", "[traversal]") {
     DeviceContext device = first_device();
     const std::string source = kernel_source("shared_types.h") +
                                "kernel void bvh4_node_size(global uint* size) {\n"
-                               "    size[0] = sizeof(Bvh8Node);\n"
-                               "    size[1] = __alignof__(Bvh8Node);\n"
+                               "    size[0] = sizeof(Bvh4Node);\n"
+                               "    size[1] = __alignof__(Bvh4Node);\n"
                                "}\n";
     cl::Program program = build_program(device.context, device.info.device, source, "");
     cl::Kernel k = make_kernel(program, "bvh4_node_size");
@@ -209,11 +209,11 @@ TEST_CASE("the device sees Bvh8Node with the host's size", "[traversal]") {
     CL_CHECK(device.queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(1)));
     cl_uint got[2] = {};
     CL_CHECK(device.queue.enqueueReadBuffer(out, CL_TRUE, 0, sizeof got, got));
-    CHECK(got[0] == sizeof(gpu::Bvh8Node));
-    CHECK(got[1] == alignof(gpu::Bvh8Node));
+    CHECK(got[0] == sizeof(gpu::Bvh4Node));
+    CHECK(got[1] == alignof(gpu::Bvh4Node));
 }
 
-TEST_CASE("a deep 8-wide tree is traversed exactly (the stack bound holds)", "[traversal]") {
+TEST_CASE("a deep 4-wide tree is traversed exactly (the stack bound holds)", "[traversal]") {
     // Triangles scattered log-uniformly over 28 decades: SAH peels them off one scale at a time,
     // giving a tree far deeper than log4(N), and rays from the origin cross every scale.
     Scene scene;
@@ -225,8 +225,8 @@ TEST_CASE("a deep 8-wide tree is traversed exactly (the stack bound holds)", "[t
         add_triangle(scene, {x, y, z}, {x + e, y, z}, {x, y + e, z}, m);
     }
     Bvh bvh = build_bvh(scene);
-    INFO("binary depth " << bvh.stats.depth << ", 8-wide depth " << bvh.stats.depth8);
-    CHECK(bvh.stats.depth8 >= 30);
+    INFO("binary depth " << bvh.stats.depth << ", 4-wide depth " << bvh.stats.depth4);
+    CHECK(bvh.stats.depth4 >= 30);
     // Rays from near the origin at each triangle's centroid: they must hit it or something nearer.
     RaySet rays;
     for (size_t t = 0; t < scene.triangle_count(); ++t) {

@@ -95,7 +95,7 @@ void check_host_structures(const mcrt::Scene& scene) {
             if (leaf < seen.size()) ++seen[leaf];
         }
     for (int n : seen) require(n == 1, "every triangle in one packet lane");
-    require(bvh.stats.depth8 <= mcrt::kMaxBvh8Depth, "BVH8 depth within the stack bound");
+    require(bvh.stats.depth4 <= mcrt::kMaxBvh4Depth, "BVH4 depth within the stack bound");
 
     std::vector<double> powers;
     for (const mcrt::EmissiveTriangle& e : mcrt::collect_emitters(scene)) powers.push_back(e.power);

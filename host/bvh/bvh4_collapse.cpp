@@ -1,6 +1,6 @@
-// Collapse of the binary SAH BVH into the 8-wide BVH the kernels traverse (Wald, Benthin, Boulos
-// 2008, "Getting rid of packets"; Embree's BVH4 and BVH8 builders collapse a binary SAH tree the
-// same way): same leaves, same triangle order, about a third of the depth.
+// Collapse of the binary SAH BVH into the 4-wide BVH the kernels traverse (Wald, Benthin, Boulos
+// 2008, "Getting rid of packets"; Embree's BVH4 builders collapse a binary SAH tree the
+// same way): same leaves, same triangle order, about half the depth.
 #include <algorithm>
 #include <cstring>
 #include <string>
@@ -12,7 +12,7 @@
 namespace mcrt {
 namespace {
 
-// Empty slots: inverted and finite, as kernels may assume no infinities (see Bvh8Node).
+// Empty slots: inverted and finite, as kernels may assume no infinities (see Bvh4Node).
 constexpr float kHuge = 1e30f;
 
 uint32_t first_of(const gpu::BvhNode& n) { return gpu::as_uint(n.lo.w); }
@@ -33,7 +33,12 @@ double node_area(const gpu::BvhNode& n) {
     return area(lo, hi);
 }
 
-constexpr int kWidth = MCRT_BVH_WIDTH;
+gpu::Bvh4Node empty_node() {
+    gpu::Bvh4Node n{};
+    n.lo_x = n.lo_y = n.lo_z = {kHuge, kHuge, kHuge, kHuge};
+    n.hi_x = n.hi_y = n.hi_z = {-kHuge, -kHuge, -kHuge, -kHuge};
+    return n;
+}
 
 void set_lane(gpu::float4& v, int lane, float f) {
     (lane == 0 ? v.x : lane == 1 ? v.y : lane == 2 ? v.z : v.w) = f;
@@ -41,20 +46,7 @@ void set_lane(gpu::float4& v, int lane, float f) {
 
 float lane(const gpu::float4& v, int i) { return i == 0 ? v.x : i == 1 ? v.y : i == 2 ? v.z : v.w; }
 
-// Slot s of a node plane (two float4s: slots 0-3, 4-7).
-void set_lane(gpu::float4 (&v)[2], int slot, float f) { set_lane(v[slot / 4], slot % 4, f); }
-float lane(const gpu::float4 (&v)[2], int slot) { return lane(v[slot / 4], slot % 4); }
-
-gpu::Bvh8Node empty_node() {
-    gpu::Bvh8Node n{};
-    for (int s = 0; s < kWidth; ++s) {
-        set_lane(n.lo_x, s, kHuge), set_lane(n.lo_y, s, kHuge), set_lane(n.lo_z, s, kHuge);
-        set_lane(n.hi_x, s, -kHuge), set_lane(n.hi_y, s, -kHuge), set_lane(n.hi_z, s, -kHuge);
-    }
-    return n;
-}
-
-void set_slot_box(gpu::Bvh8Node& n, int slot, const gpu::BvhNode& child) {
+void set_slot_box(gpu::Bvh4Node& n, int slot, const gpu::BvhNode& child) {
     set_lane(n.lo_x, slot, child.lo.x);
     set_lane(n.lo_y, slot, child.lo.y);
     set_lane(n.lo_z, slot, child.lo.z);
@@ -63,10 +55,10 @@ void set_slot_box(gpu::Bvh8Node& n, int slot, const gpu::BvhNode& child) {
     set_lane(n.hi_z, slot, child.hi.z);
 }
 
-// Area of the union of an 8-wide node's non-empty slots (its own box).
-double union_area(const gpu::Bvh8Node& n) {
+// Area of the union of a 4-wide node's non-empty slots (its own box).
+double union_area(const gpu::Bvh4Node& n) {
     float lo[3] = {kHuge, kHuge, kHuge}, hi[3] = {-kHuge, -kHuge, -kHuge};
-    for (int s = 0; s < kWidth; ++s) {
+    for (int s = 0; s < 4; ++s) {
         if (lane(n.lo_x, s) > lane(n.hi_x, s)) continue;  // empty slot
         const float l[3] = {lane(n.lo_x, s), lane(n.lo_y, s), lane(n.lo_z, s)};
         const float h[3] = {lane(n.hi_x, s), lane(n.hi_y, s), lane(n.hi_z, s)};
@@ -77,14 +69,14 @@ double union_area(const gpu::Bvh8Node& n) {
 
 }  // namespace
 
-Bvh8 collapse_to_bvh8(const std::vector<gpu::BvhNode>& nodes, float traversal_cost) {
-    if (nodes.empty()) throw RuntimeError("BVH8 collapse: the binary BVH has no root");
+Bvh4 collapse_to_bvh4(const std::vector<gpu::BvhNode>& nodes, float traversal_cost) {
+    if (nodes.empty()) throw RuntimeError("BVH4 collapse: the binary BVH has no root");
     // Only the root of an empty scene is a leaf of count 0; any other count-0 node is inner.
     const bool lone_root = nodes.size() == 1;
     auto is_inner = [&](uint32_t i) { return !lone_root && count_of(nodes[i]) == 0; };
 
-    Bvh8 out;
-    out.nodes.reserve(nodes.size() / 7 + 1);  // an 8-wide tree has about a seventh of the nodes
+    Bvh4 out;
+    out.nodes.reserve(nodes.size() / 3 + 1);  // a 4-wide tree has about a third of the nodes
     out.nodes.push_back(empty_node());
     out.depth = 1;
     if (!is_inner(0)) {
@@ -96,7 +88,7 @@ Bvh8 collapse_to_bvh8(const std::vector<gpu::BvhNode>& nodes, float traversal_co
         }
     } else {
         struct Item {
-            uint32_t bvh2, wide;
+            uint32_t bvh2, bvh4;
             int level;
         };
         std::vector<Item> stack{{0u, 0u, 1}};
@@ -104,10 +96,10 @@ Bvh8 collapse_to_bvh8(const std::vector<gpu::BvhNode>& nodes, float traversal_co
             const Item item = stack.back();
             stack.pop_back();
             out.depth = std::max(out.depth, item.level);
-            // Open the inner child of largest surface area until there are eight children.
-            uint32_t c[kWidth] = {first_of(nodes[item.bvh2]), first_of(nodes[item.bvh2]) + 1};
+            // Open the inner child of largest surface area until there are four children.
+            uint32_t c[4] = {first_of(nodes[item.bvh2]), first_of(nodes[item.bvh2]) + 1};
             int n = 2;
-            while (n < kWidth) {
+            while (n < 4) {
                 int best = -1;
                 double best_area = -1.0;
                 for (int j = 0; j < n; ++j) {
@@ -125,34 +117,34 @@ Bvh8 collapse_to_bvh8(const std::vector<gpu::BvhNode>& nodes, float traversal_co
             }
             for (int s = 0; s < n; ++s) {
                 const gpu::BvhNode& child = nodes[c[s]];
-                set_slot_box(out.nodes[item.wide], s, child);
+                set_slot_box(out.nodes[item.bvh4], s, child);
                 if (is_inner(c[s])) {
                     if (out.nodes.size() >= size_t(UINT32_MAX))
-                        throw RuntimeError("BVH8 collapse: too many nodes for 32-bit indices");
+                        throw RuntimeError("BVH4 collapse: too many nodes for 32-bit indices");
                     const uint32_t index = uint32_t(out.nodes.size());
                     out.nodes.push_back(empty_node());  // may move out.nodes: index, not ref
-                    out.nodes[item.wide].child[s] = index;
-                    out.nodes[item.wide].count[s] = 0;
+                    out.nodes[item.bvh4].child[s] = index;
+                    out.nodes[item.bvh4].count[s] = 0;
                     stack.push_back({c[s], index, item.level + 1});
                 } else {
-                    out.nodes[item.wide].child[s] = first_of(child);
-                    out.nodes[item.wide].count[s] = count_of(child);
+                    out.nodes[item.bvh4].child[s] = first_of(child);
+                    out.nodes[item.bvh4].count[s] = count_of(child);
                 }
             }
         }
     }
-    if (out.depth > kMaxBvh8Depth)
-        throw RuntimeError("BVH8 collapse: depth " + std::to_string(out.depth) +
-                           " exceeds the traversal stack's bound " + std::to_string(kMaxBvh8Depth));
+    if (out.depth > kMaxBvh4Depth)
+        throw RuntimeError("BVH4 collapse: depth " + std::to_string(out.depth) +
+                           " exceeds the traversal stack's bound " + std::to_string(kMaxBvh4Depth));
 
     // SAH cost: each node visit costs traversal_cost, each leaf its packets, weighted by the
     // probability A / A_root that a ray through the root enters it (PBRT 3rd ed. 4.3.2).
     const double root_area = union_area(out.nodes[0]);
     auto ratio = [&](double a) { return root_area > 0.0 ? a / root_area : 1.0; };
     double cost = 0.0;
-    for (const gpu::Bvh8Node& node : out.nodes) {
+    for (const gpu::Bvh4Node& node : out.nodes) {
         cost += traversal_cost * ratio(union_area(node));
-        for (int s = 0; s < kWidth; ++s) {
+        for (int s = 0; s < 4; ++s) {
             if (node.count[s] == 0) continue;
             const float lo[3] = {lane(node.lo_x, s), lane(node.lo_y, s), lane(node.lo_z, s)};
             const float hi[3] = {lane(node.hi_x, s), lane(node.hi_y, s), lane(node.hi_z, s)};
@@ -160,18 +152,18 @@ Bvh8 collapse_to_bvh8(const std::vector<gpu::BvhNode>& nodes, float traversal_co
         }
     }
     // An empty scene's root is never entered: it costs nothing.
-    const gpu::Bvh8Node& root = out.nodes[0];
+    const gpu::Bvh4Node& root = out.nodes[0];
     const bool empty = lane(root.lo_x, 0) > lane(root.hi_x, 0);
     out.sah_cost = empty ? 0.0 : cost;
     return out;
 }
 
-std::vector<gpu::TrianglePacket> pack_leaves(std::vector<gpu::Bvh8Node>& nodes,
+std::vector<gpu::TrianglePacket> pack_leaves(std::vector<gpu::Bvh4Node>& nodes,
                                              const std::vector<gpu::Triangle>& triangles) {
     std::vector<gpu::TrianglePacket> packets;
     packets.reserve(triangles.size() / 2 + 1);
-    for (gpu::Bvh8Node& node : nodes) {
-        for (int s = 0; s < kWidth; ++s) {
+    for (gpu::Bvh4Node& node : nodes) {
+        for (int s = 0; s < 4; ++s) {
             const uint32_t first = node.child[s], count = node.count[s];
             if (count == 0) continue;  // inner or empty
             if (size_t(first) + count > triangles.size())
