@@ -52,6 +52,15 @@ void add_camera_options(CLI::App* cmd, CameraOptions& o, CLI::Option* excludes) 
     if (excludes) from->excludes(excludes);
 }
 
+void add_image_size_options(CLI::App* cmd, int& width, int& height) {
+    cmd->add_option("--width", width, "image width")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 16384));
+    cmd->add_option("--height", height, "image height")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 16384));
+}
+
 std::optional<Camera> look_at_camera(const CameraOptions& o) {
     if (o.look_from.empty()) return std::nullopt;
     const glm::dvec3 eye = parse_vector("--look-from", o.look_from);

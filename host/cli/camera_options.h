@@ -1,5 +1,5 @@
 // --look-from, --look-at, --up, --fov: a camera given on the command line (DESIGN.md "Camera
-// contract"), for `render` and `bench`, in place of the scene's.
+// contract"), for `render` and `bench`, in place of the scene's; --width, --height: its image.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -19,6 +19,10 @@ struct CameraOptions {
 // Adds the four options to `cmd`; --look-from and --look-at need each other, --up and --fov
 // need them; `excludes`, if any (--camera), cannot be given with them.
 void add_camera_options(CLI::App* cmd, CameraOptions& o, CLI::Option* excludes = nullptr);
+
+// Adds --width and --height, the image's size in pixels (1 to 16384 each), for `render` and
+// `bench`.
+void add_image_size_options(CLI::App* cmd, int& width, int& height);
 
 // The camera the options give, or none when --look-from is not given. Throws InputError naming
 // the option for a vector that is not three finite numbers, --look-from equal to --look-at, or

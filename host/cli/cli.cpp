@@ -83,12 +83,7 @@ CLI::App* add_bench_command(CLI::App& app, BenchOptions& o, CameraOptions& look)
     cmd->add_option("scene", o.scene, "glTF scene (.gltf or .glb)")->required();
     cmd->add_option("--rays", o.rays, "ray kind (default: all three)")
         ->check(CLI::IsMember({"primary", "shadow", "ambient"}));
-    cmd->add_option("--width", o.width, "image width")
-        ->capture_default_str()
-        ->check(CLI::Range(1, 16384));
-    cmd->add_option("--height", o.height, "image height")
-        ->capture_default_str()
-        ->check(CLI::Range(1, 16384));
+    add_image_size_options(cmd, o.width, o.height);
     cmd->add_option("--repeats", o.repeats, "timed runs after a warm-up (median)")
         ->capture_default_str()
         ->check(CLI::Range(1, 1000));

@@ -241,12 +241,7 @@ CLI::App* add_render_command(CLI::App& app, RenderOptions& o) {
     cmd->add_option("scene", o.scene, "glTF scene (.gltf or .glb)")->required();
     cmd->add_option("--out", o.out, "output EXR")->required();
     cmd->add_option("--png", o.png, "also write an sRGB PNG");
-    cmd->add_option("--width", o.width, "image width")
-        ->capture_default_str()
-        ->check(CLI::Range(1, 16384));
-    cmd->add_option("--height", o.height, "image height")
-        ->capture_default_str()
-        ->check(CLI::Range(1, 16384));
+    add_image_size_options(cmd, o.width, o.height);
     cmd->add_option("--spp", o.spp, "samples per pixel")
         ->capture_default_str()
         ->check(CLI::Range(1u, 1u << 24));

@@ -41,26 +41,10 @@ std::string write_map(const TempDir& dir, const std::string& name, int w, int h,
     return path;
 }
 
-// A 6 × 6 floor of `albedo` at y = 0 seen from above; with hidden_light, an emitter under it facing
-// down, which puts area lights beside the map in the light choice without lighting the floor.
-Scene floor_scene(glm::dvec3 albedo, bool hidden_light) {
-    Scene scene;
-    uint32_t floor = add_material(scene, glm::vec3(albedo));
-    add_quad(scene, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, floor);
-    if (hidden_light) {
-        uint32_t light = add_material(scene, glm::vec3(0.0f), glm::vec3(10.0f));
-        add_quad(scene, {-1, -1, -1}, {1, -1, -1}, {1, -1, 1}, {-1, -1, 1}, light);
-    }
-    return scene;
-}
-
 const Camera kCamera = looking_down(glm::vec3(0, 3, 0), glm::radians(40.0f));
 
 RenderSettings env_settings(const std::string& env) {
-    RenderSettings settings;
-    settings.width = 8;
-    settings.height = 8;
-    settings.spp = 32;
+    RenderSettings settings = image_settings(8, 8, 32);
     settings.env = env;
     return settings;
 }

@@ -149,10 +149,7 @@ TEST_CASE("a point and a spot light over a floor: albedo/pi x I cos/d^2 x fallof
           "[punctual][render][analytic]") {
     DeviceContext device = first_device();
     const PunctualPlane scene(kPointAndSpot, false);
-    RenderSettings settings;
-    settings.width = 12;
-    settings.height = 12;
-    settings.spp = 32;
+    RenderSettings settings = image_settings(12, 12, 32);
     const GpuSceneData data = gpu_scene_for(scene.ps.scene, scene.ps.camera, settings);
     REQUIRE(data.punctual.size() == 2);
     REQUIRE(data.lights.empty());
@@ -194,10 +191,7 @@ TEST_CASE("a directional light at an angle: albedo/pi x E cos, and a blocker's s
              {hi.x, hi.y, lo.z}, grey);  // top, facing +Y
     add_quad(scene.ps.scene, {lo.x, lo.y, lo.z}, {lo.x, lo.y, hi.z}, {lo.x, hi.y, hi.z},
              {lo.x, hi.y, lo.z}, grey);  // the side facing the light (−X)
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 16;
-    settings.spp = 16;
+    RenderSettings settings = image_settings(16, 16, 16);
     const GpuSceneData data = gpu_scene_for(scene.ps.scene, scene.ps.camera, settings);
     // The camera (looking down from height 3, 40°) sees x, z in ±3 tan 20° = ±1.09.
     const double half = 3.0 * std::tan(glm::radians(20.0));
@@ -241,10 +235,7 @@ TEST_CASE("every light selection gives the same image of punctual and area light
     lights.push_back(
         spot_light({-0.6f, 0.9f, -0.5f}, {0.0f, -1.0f, 0.0f}, {2.0f, 2.0f, 2.0f}, 25.0, 25.0));
     const PunctualPlane scene(lights, true);
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 16;
-    settings.spp = 32;
+    RenderSettings settings = image_settings(16, 16, 32);
     const glm::dvec3 exact = image_mean(scene.exact_image(settings.width, settings.height));
     for (const char* estimator : {"light-area", "mis"})
         for (const std::string& select : variant_names(kLightSelectVariants)) {
@@ -303,10 +294,7 @@ TEST_CASE("punctual lights render the same bytes on one device or two", "[punctu
     std::vector<PunctualLight> lights = kPointAndSpot;
     lights.push_back(directional_light({-0.3f, -1.0f, 0.5f}, {0.4f, 0.5f, 0.6f}));
     const PunctualPlane scene(lights, true);
-    RenderSettings settings;
-    settings.width = 40;
-    settings.height = 32;
-    settings.spp = 48;
+    RenderSettings settings = image_settings(40, 32, 48);
     settings.estimator = "mis";
     settings.light_select = "tree";
     settings.max_depth = 3;

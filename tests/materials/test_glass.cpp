@@ -748,10 +748,7 @@ TEST_CASE("every path estimator renders the same mean through rough and smooth g
         add_quad(scene, {-0.3f, 1.2f, -0.3f}, {0.3f, 1.2f, -0.3f}, {0.3f, 1.2f, 0.3f},
                  {-0.3f, 1.2f, 0.3f}, light);
         Camera camera = looking_down(glm::vec3(0.2f, 2.5f, 0.1f), glm::radians(60.0f));
-        RenderSettings settings;
-        settings.width = 8;
-        settings.height = 8;
-        settings.spp = 256;
+        RenderSettings settings = image_settings(8, 8, 256);
         settings.sky = glm::vec3(0.2f);
         settings.sky_light = true;
         settings.max_depth = 4;
@@ -824,10 +821,7 @@ TEST_CASE("a smooth glass slab over a Lambertian floor under the sky: the floor'
     add_quad(scene, {-w, y0, -w}, {-w, y0, w}, {-w, y1, w}, {-w, y1, -w}, glass);  // −x
     Camera camera = looking_down(glm::vec3(0.0f, 0.25f, 0.0f), glm::radians(30.0f));
     DeviceContext device = first_device();
-    RenderSettings settings;
-    settings.width = 8;
-    settings.height = 8;
-    settings.spp = 64;
+    RenderSettings settings = image_settings(8, 8, 64);
     settings.sky = glm::vec3(1.0f);
     settings.sky_light = true;
     settings.max_depth = MCRT_MAX_PATH_DEPTH;
@@ -872,10 +866,7 @@ TEST_CASE("transmissionTexture scales transmissionFactor by its R channel", "[gl
     };
     Camera camera = looking_down(glm::vec3(0.0f, 1.0f, 0.0f), glm::radians(30.0f));
     DeviceContext device = first_device();
-    RenderSettings settings;
-    settings.width = 8;
-    settings.height = 8;
-    settings.spp = 64;
+    RenderSettings settings = image_settings(8, 8, 64);
     settings.sky = glm::vec3(1.0f);
     settings.sky_light = true;
     settings.max_depth = 16;

@@ -477,10 +477,7 @@ TEST_CASE("direct-light estimators are unbiased on glossy planes under a quad li
 TEST_CASE("a mirror-like metal (roughness 0) renders finite with every direct estimator",
           "[materials][estimators]") {
     DeviceContext device = first_device();
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 16;
-    settings.spp = 16;
+    RenderSettings settings = image_settings(16, 16, 16);
     GlossyPlane gp(metal(0.0));
     GpuSceneData data = gpu_scene_for(gp.scene, gp.camera, settings);
     for (const EstimatorCase& v : estimator_cases(kUsesLights, kUsesSky)) {
@@ -504,10 +501,7 @@ TEST_CASE("Lambertian scenes build without the microfacet code and render bitwis
     // Lambertian, and renders bitwise as --materials lambert does.
     Scene as_exported =
         load_gltf(std::string(MCRT_SCENES) + "/cornell/CornellBox-Original.gltf", {});
-    RenderSettings settings;
-    settings.width = 24;
-    settings.height = 24;
-    settings.spp = 16;
+    RenderSettings settings = image_settings(24, 24, 16);
     settings.estimator = "mis";
     const Camera camera = as_exported.cameras.front();
     GpuSceneData glossy = gpu_scene_for(as_exported, camera, settings);

@@ -49,10 +49,7 @@ View load_view(const std::string& file, int camera, const RenderSettings& settin
 }
 
 RenderSettings view_settings(const json& view) {
-    RenderSettings settings;
-    settings.width = view["resolution"][0];
-    settings.height = view["resolution"][1];
-    settings.spp = 16;
+    RenderSettings settings = image_settings(view["resolution"][0], view["resolution"][1], 16);
     settings.estimator = "light-area";
     settings.seed = 7;
     return settings;

@@ -61,10 +61,7 @@ void set_texcoords(Scene& s, F uv, bool second = false) {
 }
 
 RenderSettings small_settings() {
-    RenderSettings settings;
-    settings.width = 24;
-    settings.height = 24;
-    settings.spp = 16;
+    RenderSettings settings = image_settings(24, 24, 16);
     settings.estimator = "light-area";
     return settings;
 }

@@ -219,10 +219,7 @@ TEST_CASE("every example estimator counts the sky light: under --sky its mean is
     // error bar, which the second check makes sure of.
     DeviceContext device = first_device();
     Scene scene = load_gltf(kCornell, nullptr);
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 16;
-    settings.spp = 64;
+    RenderSettings settings = image_settings(16, 16, 64);
     settings.sky = glm::vec3(0.5f);
     settings.sky_light = true;
     GpuSceneData data = gpu_scene_for(scene, scene.cameras.front(), settings);
@@ -255,10 +252,7 @@ TEST_CASE("every example estimator is unbiased on a polygon light over a plane",
           "[estimator-file][estimators][analytic]") {
     DeviceContext device = first_device();
     PlaneScene ps;
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 16;
-    settings.spp = 64;
+    RenderSettings settings = image_settings(16, 16, 64);
     GpuSceneData data = gpu_scene_for(ps.scene, ps.camera, settings);
     glm::dvec3 exact = image_mean(ps.exact_image(settings.width, settings.height));
     const std::vector<std::string> files = example_estimator_files();

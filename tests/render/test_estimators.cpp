@@ -25,10 +25,7 @@ TEST_CASE("direct-light estimators are unbiased on a polygon light over a plane"
           "[estimators][analytic]") {
     DeviceContext device = first_device();
     PlaneScene ps;
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 16;
-    settings.spp = 64;
+    RenderSettings settings = image_settings(16, 16, 64);
     GpuSceneData data = gpu_scene_for(ps.scene, ps.camera, settings);
     glm::dvec3 exact = image_mean(ps.exact_image(settings.width, settings.height));
 
@@ -62,10 +59,7 @@ TEST_CASE("in a furnace every estimator is unbiased and the cosine estimator has
     const Scene& scene = furnace.scene;
     const glm::vec3 Le = furnace.Le, albedo = furnace.albedo;
     const Camera& camera = furnace.camera;
-    RenderSettings settings;
-    settings.width = 8;
-    settings.height = 8;
-    settings.spp = 32;
+    RenderSettings settings = image_settings(8, 8, 32);
     GpuSceneData data = gpu_scene_for(scene, camera, settings);
     glm::dvec3 exact = glm::dvec3(Le) * (1.0 + glm::dvec3(albedo));
     for (const EstimatorCase& v : estimator_cases(kUsesLights, kUsesSky | kUsesMisHeuristic)) {
@@ -103,10 +97,7 @@ TEST_CASE("ambient estimators are unbiased next to a wall (its projected solid a
     std::vector<glm::dvec3> wall_polygon = {{0, 0, -1.5}, {0, 1, -1.5}, {0, 1, 1.5}, {0, 0, 1.5}};
     add_quad(scene, wall_polygon[0], wall_polygon[1], wall_polygon[2], wall_polygon[3], wall);
     Camera camera = looking_down(glm::vec3(0.7f, 3.0f, 0.0f), 2.0f * std::atan(0.5f / 3.0f));
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 16;
-    settings.spp = 64;
+    RenderSettings settings = image_settings(16, 16, 64);
     settings.sky = glm::vec3(sky);
     GpuSceneData data = gpu_scene_for(scene, camera, settings);
     glm::dvec3 exact = image_mean(exact_plane_image(camera, 16, 16, [&](glm::dvec3 p) {
@@ -132,10 +123,7 @@ TEST_CASE("ambient occlusion distance: a far wall stops occluding", "[estimators
     add_quad(scene, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, floor);
     add_quad(scene, {0, 0, -1.5}, {0, 1, -1.5}, {0, 1, 1.5}, {0, 0, 1.5}, floor);
     Camera camera = looking_down(glm::vec3(0.7f, 3.0f, 0.0f), 0.2f);
-    RenderSettings settings;
-    settings.width = 4;
-    settings.height = 4;
-    settings.spp = 64;
+    RenderSettings settings = image_settings(4, 4, 64);
     settings.estimator = "ambient-cosine";
     settings.ao_distance = 0.1f;  // the wall is 0.6 or more away: nothing occludes
     GpuSceneData data = gpu_scene_for(scene, camera, settings);
@@ -147,10 +135,7 @@ TEST_CASE("power and alias selection have lower variance than uniform with unequ
           "[estimators]") {
     DeviceContext device = first_device();
     PlaneScene ps;
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 16;
-    settings.spp = 64;
+    RenderSettings settings = image_settings(16, 16, 64);
     GpuSceneData data = gpu_scene_for(ps.scene, ps.camera, settings);
     double layer[3];
     const char* selections[3] = {"uniform", "power", "alias"};
@@ -169,10 +154,7 @@ TEST_CASE("with the independent sampler the variance layer predicts the spread o
           "[estimators]") {
     DeviceContext device = first_device();
     PlaneScene ps;
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 16;
-    settings.spp = 32;
+    RenderSettings settings = image_settings(16, 16, 32);
     GpuSceneData data = gpu_scene_for(ps.scene, ps.camera, settings);
     const int renders = 40;
     Renders r = independent_renders(device, data, settings, renders, kFirstSeed);
@@ -194,10 +176,7 @@ TEST_CASE("the variance layer predicts the spread of renders for every estimator
     // variance of each pixel across 16 independent renders: within 35%.
     DeviceContext device = first_device();
     PlaneScene ps;
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 16;
-    settings.spp = 64;
+    RenderSettings settings = image_settings(16, 16, 64);
     GpuSceneData plane = gpu_scene_for(ps.scene, ps.camera, settings);
     // Ambient light next to a wall, as the ambient test: the sky estimators' scene.
     Scene ambient;

@@ -11,6 +11,7 @@
 #include "bvh/bvh.h"
 #include "common/error.h"
 #include "image/image.h"
+#include "independent_renders.h"
 #include "process_support.h"
 #include "render/renderer.h"
 #include "scene/gltf_import.h"
@@ -108,10 +109,7 @@ TEST_CASE("paths of depth 8 render bit for bit alike on one device or two and in
           "[multidevice][paths]") {
     Devices devices;
     Scene scene = load_gltf(kCornell, [](const std::string&) {});
-    RenderSettings settings;
-    settings.width = 24;
-    settings.height = 24;
-    settings.spp = 48;
+    RenderSettings settings = image_settings(24, 24, 48);
     settings.max_depth = 8;
     settings.rr_depth = 3;
     GpuSceneData data = make_gpu_scene(scene, build_bvh(scene), scene.cameras.front(),

@@ -53,10 +53,7 @@ TEST_CASE("a closed furnace renders Le (1 - rho^(N+1)) / (1 - rho) at depth N",
     const Scene& scene = furnace.scene;
     const glm::vec3 Le = furnace.Le, albedo = furnace.albedo;
     const Camera& camera = furnace.camera;
-    RenderSettings settings;
-    settings.width = 8;
-    settings.height = 8;
-    settings.spp = 32;
+    RenderSettings settings = image_settings(8, 8, 32);
     GpuSceneData data = gpu_scene_for(scene, camera, settings);
     struct Depth {
         uint32_t max_depth, rr_depth;
@@ -92,10 +89,7 @@ TEST_CASE("roulette ends paths and leaves the furnace unbiased; its stats count 
     uint32_t m = add_material(scene, glm::vec3(0.5f), glm::vec3(1.0f));
     add_sphere(scene, glm::vec3(0.0f), 1.0f, 16, 8, m, /*inward=*/true);
     Camera camera = looking_down(glm::vec3(0.0f), glm::radians(60.0f));
-    RenderSettings settings;
-    settings.width = 8;
-    settings.height = 8;
-    settings.spp = 64;
+    RenderSettings settings = image_settings(8, 8, 64);
     settings.estimator = "light-area";
     settings.max_depth = 1024;
     settings.rr_depth = 1;
@@ -123,27 +117,14 @@ TEST_CASE("an open floor under a uniform sky renders albedo x L_sky at every dep
     // lighting the floor.
     DeviceContext device = first_device();
     const glm::dvec3 albedo(0.7, 0.5, 0.3), sky(1.0, 2.0, 0.5);
-    auto floor_scene = [&](bool hidden_light) {
-        Scene scene;
-        uint32_t floor = add_material(scene, glm::vec3(albedo));
-        add_quad(scene, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, floor);
-        if (hidden_light) {
-            uint32_t light = add_material(scene, glm::vec3(0.0f), glm::vec3(10.0f));
-            add_quad(scene, {-1, -1, -1}, {1, -1, -1}, {1, -1, 1}, {-1, -1, 1}, light);
-        }
-        return scene;
-    };
     Camera camera = looking_down(glm::vec3(0, 3, 0), glm::radians(40.0f));
-    RenderSettings settings;
-    settings.width = 8;
-    settings.height = 8;
-    settings.spp = 32;
+    RenderSettings settings = image_settings(8, 8, 32);
     settings.sky = glm::vec3(sky);
     settings.sky_light = true;
     const std::vector<EstimatorCase> cases = estimator_cases(kUsesSkyLight);
     REQUIRE(cases.size() >= 6);
     for (bool hidden_light : {false, true}) {
-        Scene scene = floor_scene(hidden_light);
+        Scene scene = floor_scene(albedo, hidden_light);
         GpuSceneData data = gpu_scene_for(scene, camera, settings);
         for (uint32_t depth : {1u, 2u, 8u})
             for (const EstimatorCase& v : cases) {
@@ -164,10 +145,7 @@ TEST_CASE("without --sky a direct estimator's escaping rays see black", "[paths]
     add_quad(scene, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3},
              add_material(scene, glm::vec3(0.5f)));
     Camera camera = looking_down(glm::vec3(0, 3, 0), glm::radians(120.0f));  // sees past the floor
-    RenderSettings settings;
-    settings.width = 8;
-    settings.height = 8;
-    settings.spp = 16;
+    RenderSettings settings = image_settings(8, 8, 16);
     settings.sky = glm::vec3(3.0f);  // radiance given, but no sky light
     settings.max_depth = 4;
     GpuSceneData data = gpu_scene_for(scene, camera, settings);
@@ -190,10 +168,7 @@ TEST_CASE("the variance layer predicts the spread of path-traced renders for eve
     Scene scene;
     uint32_t m = add_material(scene, glm::vec3(0.7f, 0.5f, 0.3f), glm::vec3(1.0f));
     add_sphere(scene, glm::vec3(0.0f), 1.0f, 16, 8, m, /*inward=*/true);
-    RenderSettings settings;
-    settings.width = 8;
-    settings.height = 8;
-    settings.spp = 32;
+    RenderSettings settings = image_settings(8, 8, 32);
     settings.max_depth = 64;
     settings.rr_depth = 2;
     GpuSceneData data = gpu_scene_for(

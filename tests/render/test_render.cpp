@@ -7,6 +7,7 @@
 #include "analytic_scenes.h"
 #include "bvh/bvh.h"
 #include "device_support.h"
+#include "independent_renders.h"
 #include "render/renderer.h"
 #include "scene_builders.h"
 
@@ -78,10 +79,7 @@ TEST_CASE("light-area is unbiased on a polygon light over a plane (Lambert's for
 TEST_CASE("power selection has lower variance than uniform when light powers differ",
           "[render][analytic]") {
     PlaneScene ps;
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 16;
-    settings.spp = 64;
+    RenderSettings settings = image_settings(16, 16, 64);
     double var_sum[2] = {0, 0};
     for (int power = 0; power < 2; ++power) {
         settings.light_select = power ? "power" : "uniform";
@@ -93,10 +91,7 @@ TEST_CASE("power selection has lower variance than uniform when light powers dif
 }
 
 TEST_CASE("an emitter seen directly shows Le on its emitting faces only", "[render]") {
-    RenderSettings settings;
-    settings.width = 8;
-    settings.height = 8;
-    settings.spp = 16;
+    RenderSettings settings = image_settings(8, 8, 16);
     const glm::vec3 Le(2.0f, 3.0f, 4.0f);
     for (bool double_sided : {false, true})
         for (bool from_front : {true, false}) {
@@ -158,10 +153,7 @@ TEST_CASE("a scene without lights renders black without error", "[render]") {
     Scene scene;
     add_quad(scene, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3},
              add_material(scene, glm::vec3(0.8f)));
-    RenderSettings settings;
-    settings.width = 8;
-    settings.height = 8;
-    settings.spp = 4;
+    RenderSettings settings = image_settings(8, 8, 4);
     RenderResult r = render_scene(scene, looking_down({0, 2, 0}, 0.5f), settings);
     for (float v : r.image.rgb) CHECK(v == 0.0f);
     CHECK(r.nan_samples == 0);
@@ -188,10 +180,7 @@ TEST_CASE("an emitter of 1e30 renders a finite image and variance layer", "[rend
     add_quad(scene, {-0.3f, 0.5f, -0.3f}, {-0.3f, 0.5f, 0.3f}, {0.3f, 0.5f, 0.3f},
              {0.3f, 0.5f, -0.3f}, light);
     Camera camera = looking_down(glm::vec3(0.0f, 3.0f, 0.0f), glm::radians(60.0f));
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 16;
-    settings.spp = 32;
+    RenderSettings settings = image_settings(16, 16, 32);
     for (const char* estimator : {"light-area", "hemisphere-cosine"}) {
         settings.estimator = estimator;
         RenderResult r = render_scene(scene, camera, settings);

@@ -91,10 +91,7 @@ TEST_CASE("the camera sees a single-sided quad from the front, and what is behin
     // counts emission at the first hit alone, so each pixel is exactly what the camera ray hits.
     DeviceContext device = first_device();
     const glm::vec3 backdrop_Le(0.25f, 0.5f, 1.0f), quad_Le(2.0f, 2.0f, 2.0f);
-    RenderSettings settings;
-    settings.width = 8;
-    settings.height = 8;
-    settings.spp = 4;
+    RenderSettings settings = image_settings(8, 8, 4);
     settings.max_depth = 0;
     const Camera camera = looking_down(glm::vec3(0.0f, 2.0f, 0.0f), glm::radians(40.0f));
     struct Case {
@@ -134,10 +131,7 @@ TEST_CASE(
     // image is that of the scene without it, for light-area, bsdf and mis within their standard
     // errors. Facing down it shadows the floor. Direct light (depth 1) isolates visibility.
     DeviceContext device = first_device();
-    RenderSettings settings;
-    settings.width = 8;
-    settings.height = 8;
-    settings.spp = 64;
+    RenderSettings settings = image_settings(8, 8, 64);
     settings.max_depth = 1;
     const Camera camera = looking_down(glm::vec3(0.0f, 0.9f, 0.0f), glm::radians(90.0f));
     auto scene = [](int occluder) {  // 0: none, 1: facing away from the floor, 2: facing it
@@ -192,10 +186,7 @@ TEST_CASE("a single-sided glass sphere is hit from inside: transmissive surfaces
         // Ambient occlusion under a sky of 1: a camera ray that leaves the scene sees exactly 1;
         // one that hits the inside of the closed sphere sees 0, its every ambient ray blocked
         // (shadow rays stop at glass).
-        RenderSettings settings;
-        settings.width = 8;
-        settings.height = 8;
-        settings.spp = 4;
+        RenderSettings settings = image_settings(8, 8, 4);
         settings.estimator = "ambient-cosine";
         settings.sky = glm::vec3(1.0f);
         const Camera camera = looking_down(glm::vec3(0.0f), glm::radians(60.0f));
@@ -219,10 +210,7 @@ TEST_CASE("a single-sided glass sphere is hit from inside: transmissive surfaces
         // The floor is seen from its front only, so a single-sided floor (culling built in, the
         // glass not flagged) and a double-sided one (no culling code) must give the same image,
         // paths through the sphere's inside included.
-        RenderSettings settings;
-        settings.width = 12;
-        settings.height = 12;
-        settings.spp = 32;
+        RenderSettings settings = image_settings(12, 12, 32);
         settings.max_depth = 8;
         settings.estimator = "mis";
         const Camera camera = looking_down(glm::vec3(0.1f, 3.0f, 0.0f), glm::radians(40.0f));

@@ -278,10 +278,7 @@ TEST_CASE(
 TEST_CASE("stress scenes: every example estimator file is finite and unbiased",
           "[stress][estimators][analytic][estimator-file]") {
     DeviceContext device = first_device();
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 16;
-    settings.spp = 32;
+    RenderSettings settings = image_settings(16, 16, 32);
     const std::vector<std::string> files = example_estimator_files();
     REQUIRE(files.size() >= 2);
     for (const std::string& name : kStressScenes) {
@@ -320,10 +317,7 @@ TEST_CASE("stress: a light facing away from the receiver adds exactly nothing",
     Scene scene = load_stress_scene("light-facing-away");
     for (Material& m : scene.materials)
         if (m.name == "dim light") m.emission = glm::vec3(0.0f);
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 16;
-    settings.spp = 64;
+    RenderSettings settings = image_settings(16, 16, 64);
     Bvh bvh = build_bvh(scene);
     GpuSceneData data =
         make_gpu_scene(scene, bvh, scene.cameras.front(), settings.width, settings.height);

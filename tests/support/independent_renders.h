@@ -16,6 +16,15 @@
 
 namespace mcrt::test {
 
+// Settings for a width × height image at spp samples per pixel, every other setting its default.
+inline RenderSettings image_settings(int width, int height, uint32_t spp) {
+    RenderSettings settings;
+    settings.width = width;
+    settings.height = height;
+    settings.spp = spp;
+    return settings;
+}
+
 // One estimator of the table of variants with one MIS heuristic (every heuristic for the
 // estimators that use one, else the default): the cases the statistical suites run.
 struct EstimatorCase {

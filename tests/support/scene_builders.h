@@ -51,6 +51,20 @@ inline void add_sphere(Scene& s, glm::vec3 centre, float radius, int slices, int
         }
 }
 
+// A 6 × 6 floor of `albedo` at y = 0, to be seen from above; with hidden_light, an emitter
+// under it facing down, which puts an area light beside the sky or the map in the light choice
+// without lighting the floor.
+inline Scene floor_scene(glm::dvec3 albedo, bool hidden_light) {
+    Scene scene;
+    uint32_t floor = add_material(scene, glm::vec3(albedo));
+    add_quad(scene, {-3, 0, -3}, {-3, 0, 3}, {3, 0, 3}, {3, 0, -3}, floor);
+    if (hidden_light) {
+        uint32_t light = add_material(scene, glm::vec3(0.0f), glm::vec3(10.0f));
+        add_quad(scene, {-1, -1, -1}, {1, -1, -1}, {1, -1, 1}, {-1, -1, 1}, light);
+    }
+    return scene;
+}
+
 // n random triangles with vertices in [0, 1]³ and edges up to `size` long.
 inline void add_random_triangles(Scene& s, int n, float size, uint32_t material, uint32_t seed) {
     std::mt19937 rng(seed);
