@@ -229,12 +229,9 @@ class ThreadBudget {
     std::atomic<int> spare_;
 };
 
-// Binary levels collapsed into one node of LIGHT_TREE_WIDTH = 2^kLevels slots.
-constexpr int kLevels = 3;
-static_assert(LIGHT_TREE_WIDTH == 1 << kLevels);
-// Longest path of the binary tree, in edges: collapsed kLevels levels to a node, its lights lie
-// at most MCRT_LIGHT_TREE_MAX_DEPTH nodes deep.
-constexpr int kMaxBinaryDepth = kLevels * MCRT_LIGHT_TREE_MAX_DEPTH;
+// Longest path of the binary tree, in edges: collapsed two levels to a node, its lights lie at
+// most MCRT_LIGHT_TREE_MAX_DEPTH nodes deep.
+constexpr int kMaxBinaryDepth = 2 * MCRT_LIGHT_TREE_MAX_DEPTH;
 // Subtrees of more lights than this are built on a thread of their own while threads are free.
 constexpr size_t kParallelGrain = 4096;
 // Splits of more than twice this many lights bin and partition in chunks of it, in parallel.
@@ -249,26 +246,8 @@ struct BinaryNode {
     uint32_t right = 0;
     uint32_t light = 0;  // leaf: its light
     bool leaf = false;
-    uint32_t wide_nodes = 0;  // the nodes of the wide tree this node would root
+    uint32_t wide_nodes = 0;  // the nodes of the four-wide tree this node would root
 };
-
-// The slots of the wide node that inner binary node b becomes: its descendants kLevels levels
-// down, or a leaf met above them, in slot `base` of the `width` slots its branch owns, so that
-// the slots [0, width/2) and [width/2, width) are the two sides of b's split, and so on down:
-// the kernels' cuts, halves first, follow the binary splits. used[k]: slot k holds a node.
-void wide_slots(const BinaryNode* binary, uint32_t b, uint32_t* slots, int* used, int base = 0,
-                int width = LIGHT_TREE_WIDTH) {
-    if (base == 0 && width == LIGHT_TREE_WIDTH)
-        for (int k = 0; k < LIGHT_TREE_WIDTH; ++k) used[k] = 0;
-    const BinaryNode& n = binary[b];
-    if (width == 1 || n.leaf) {
-        slots[base] = b;
-        used[base] = 1;
-        return;
-    }
-    wide_slots(binary, n.left, slots, used, base, width / 2);
-    wide_slots(binary, n.right, slots, used, base + width / 2, width / 2);
-}
 
 // Top-down binary build, depth first: the subtree over order[begin, end) of m lights takes the
 // 2m − 1 nodes from its index on, so that subtrees are built apart (in parallel) into places
@@ -353,13 +332,14 @@ struct BinaryBuilder {
             build(begin, mid, left, depth + 1, &halves[0]);
             build(mid, end, right, depth + 1, &halves[1]);
         }
-        // As the root of a wide node: itself and the nodes below its inner slots.
-        uint32_t slots[LIGHT_TREE_WIDTH];
-        int used[LIGHT_TREE_WIDTH];
-        wide_slots(nodes, index, slots, used);
+        // As the root of a four-wide node: itself and the nodes below its inner slots.
         uint32_t wide = 1;
-        for (int k = 0; k < LIGHT_TREE_WIDTH; ++k)
-            if (used[k] && !nodes[slots[k]].leaf) wide += nodes[slots[k]].wide_nodes;
+        for (uint32_t half : {left, right}) {
+            const BinaryNode& c = nodes[half];
+            if (c.leaf) continue;
+            for (uint32_t slot : {c.left, c.right})
+                if (!nodes[slot].leaf) wide += nodes[slot].wide_nodes;
+        }
         node.wide_nodes = wide;
     }
 
@@ -424,9 +404,9 @@ struct BinaryBuilder {
             sides(begin, begin + 1, end, halves);
             return begin + 1;
         }
-        // Up to eight lights all become slots of one node however they are split (Collapser):
-        // the splits only group them for the node's cuts, and the median groups neighbours.
-        const bool balance = n <= LIGHT_TREE_WIDTH || depth + ceil_log2(n) >= kMaxBinaryDepth;
+        // Up to four lights all become slots of one node however they are split (Collapser):
+        // the split only pairs them for the node's first cut, and the median pairs neighbours.
+        const bool balance = n <= 4 || depth + ceil_log2(n) >= kMaxBinaryDepth;
         const glm::dvec3 diagonal = all.hi - all.lo, extent = centroids.hi - centroids.lo;
         double best_cost = std::numeric_limits<double>::infinity();
         int best_dim = -1, best_bucket = -1;
@@ -574,20 +554,18 @@ void set_slot(gpu::LightTreeNode& node, int k, const Bounds& b, uint32_t child, 
     const double cos_eps = 0.9999999999995, sin_eps = 1e-6;  // of ε, to double precision
     const double cos_o = s * cos_eps + c * sin_eps < 0.0 ? -1.0 : c * cos_eps - s * sin_eps;
     const float cos_o_f = round_down(cos_o);
-    gpu::LightSlots& h = node.group[k / 4];
-    const int c4 = k % 4;
-    (&h.x.x)[c4] = float(centre.x);
-    (&h.y.x)[c4] = float(centre.y);
-    (&h.z.x)[c4] = float(centre.z);
-    (&h.radius.x)[c4] = round_up(glm::length(reach));
-    (&h.ax.x)[c4] = float(b.normals.w.x);
-    (&h.ay.x)[c4] = float(b.normals.w.y);
-    (&h.az.x)[c4] = float(b.normals.w.z);
-    (&h.cos_o.x)[c4] = cos_o_f;
-    (&h.sin_o.x)[c4] =
+    (&node.x.x)[k] = float(centre.x);
+    (&node.y.x)[k] = float(centre.y);
+    (&node.z.x)[k] = float(centre.z);
+    (&node.radius.x)[k] = round_up(glm::length(reach));
+    (&node.ax.x)[k] = float(b.normals.w.x);
+    (&node.ay.x)[k] = float(b.normals.w.y);
+    (&node.az.x)[k] = float(b.normals.w.z);
+    (&node.cos_o.x)[k] = cos_o_f;
+    (&node.sin_o.x)[k] =
         std::min(1.0f, round_up(std::sqrt(std::max(0.0, 1.0 - double(cos_o_f) * double(cos_o_f)))));
-    (&h.cos_e.x)[c4] = round_down(b.cos_e);
-    (&h.phi.x)[c4] = float(b.phi);
+    (&node.cos_e.x)[k] = round_down(b.cos_e);
+    (&node.phi.x)[k] = float(b.phi);
     node.child[k] = child;
     if (leaf) node.flags |= LIGHT_SLOT_LEAF << k;
     if (b.two_sided) node.flags |= LIGHT_SLOT_TWO_SIDED << k;
@@ -596,23 +574,39 @@ void set_slot(gpu::LightTreeNode& node, int k, const Bounds& b, uint32_t child, 
 gpu::LightTreeNode empty_node() {
     gpu::LightTreeNode node{};
     // No power, and cos θ_e = 1, which no cos θ' exceeds: no importance.
-    for (gpu::LightSlots& h : node.group) h.cos_o = h.cos_e = {1.0f, 1.0f, 1.0f, 1.0f};
+    node.cos_o = node.cos_e = {1.0f, 1.0f, 1.0f, 1.0f};
     return node;
 }
 
-// Collapses the binary tree kLevels levels to a node (wide_slots), so that the kernels' first
-// cut, between the two halves of the slots, is the binary split. Nodes are laid out depth
-// first; each subtree's node count known from the binary build (BinaryNode::wide_nodes),
-// subtrees are written apart (in parallel) into places fixed by the tree alone.
+// Collapses the binary tree two levels to a node: slots 0, 1 from the first child (itself if a
+// leaf, else its two children), slots 2, 3 from the second, so that the kernels' first cut,
+// between the two pairs, is the binary split. Nodes are laid out depth first; each subtree's
+// node count known from the binary build (BinaryNode::wide_nodes), subtrees are written apart
+// (in parallel) into places fixed by the tree alone.
 struct Collapser {
     const BinaryNode* binary;
     LightTree& out;
     ThreadBudget& budget;
 
+    // The slots of the node that binary node b becomes.
+    int slots_of(uint32_t b, uint32_t* slots, int* used) const {
+        int n = 0;
+        const uint32_t halves[2] = {binary[b].left, binary[b].right};
+        for (int h = 0; h < 2; ++h) {
+            const BinaryNode& c = binary[halves[h]];
+            used[2 * h] = 1;
+            used[2 * h + 1] = c.leaf ? 0 : 1;
+            slots[2 * h] = c.leaf ? halves[h] : c.left;
+            slots[2 * h + 1] = c.leaf ? 0u : c.right;
+            n += c.leaf ? 1 : 2;
+        }
+        return n;
+    }
+
     void collapse(uint32_t b, uint32_t index, uint32_t trail, uint32_t depth) {
-        uint32_t slots[LIGHT_TREE_WIDTH];
-        int used[LIGHT_TREE_WIDTH];
-        wide_slots(binary, b, slots, used);
+        uint32_t slots[4];
+        int used[4];
+        slots_of(b, slots, used);
         place(slots, used, index, trail, depth);
     }
 
@@ -621,10 +615,10 @@ struct Collapser {
         out.nodes[index] = empty_node();
         uint32_t next = index + 1;
         std::vector<std::thread> threads;
-        for (int k = 0; k < LIGHT_TREE_WIDTH; ++k) {
+        for (int k = 0; k < 4; ++k) {
             if (!used[k]) continue;
             const BinaryNode& c = binary[slots[k]];
-            const uint32_t slot_trail = trail | (uint32_t(k) << (kLevels * depth));
+            const uint32_t slot_trail = trail | (uint32_t(k) << (2 * depth));
             if (c.leaf) {
                 set_slot(out.nodes[index], k, c.bounds, c.light, true);
                 out.paths[c.light] = {slot_trail, depth + 1};
@@ -776,8 +770,8 @@ LightTree build_light_tree(const std::vector<gpu::Light>& lights, const std::vec
     });
     Collapser collapser{binary, tree, budget};
     if (binary[0].leaf) {  // one light: a root of one slot
-        const uint32_t slots[LIGHT_TREE_WIDTH] = {};
-        const int used[LIGHT_TREE_WIDTH] = {1};
+        const uint32_t slots[4] = {0u, 0u, 0u, 0u};
+        const int used[4] = {1, 0, 0, 0};
         tree.nodes.resize(1);
         collapser.place(slots, used, 0u, 0u, 0u);
     } else {

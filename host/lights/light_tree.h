@@ -14,7 +14,7 @@ namespace mcrt {
 
 struct LightTree {
     std::vector<gpu::LightTreeNode> nodes;  // nodes[0] the root; empty when no light has power
-    // Per light: its path from the root (bits 3d to 3d + 2: the slot taken at depth d) and the
+    // Per light: its path from the root (bits 2d, 2d + 1: the slot taken at depth d) and the
     // path's number of nodes, 0 for a light outside the tree (zero power): what the kernels'
     // pmf twin walks, uploaded after the nodes.
     std::vector<gpu::LightTreePath> paths;
@@ -36,7 +36,7 @@ struct LightTreeItem {
 // tree top-down, binned (12 buckets per axis) with pbrt-v4's surface-area-orientation cost:
 // power × the orientation measure M_Ω of the cone × surface area × the box's aspect penalty,
 // its subtrees built on `threads` threads (0: one per core; the tree is the same for any
-// number); then collapsed three levels to a node of eight slots, a slot holding one light or a
+// number); then collapsed two levels to a node of four slots, a slot holding one light or a
 // node. No path is longer than MCRT_LIGHT_TREE_MAX_DEPTH nodes.
 // `more` are lights lights.size() + k after the triangles (their inclusion, as every light's,
 // decided by `powers`, which has an entry for each); a tree without them is the same as before.

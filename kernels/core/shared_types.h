@@ -212,14 +212,17 @@ typedef struct {
     uint pad0;
 } PunctualGpu;
 
-/* Four slots of a light tree node, 176 bytes, with the bounds of the lights below each for the
- * importance of kernels/lights/light_tree.cl (Conty Estevez & Kulla 2018; pbrt-v4's
- * LightBounds), one float4 per quantity so that four importances are one vector computation.
- * Per slot k (the vectors' component k):
+/* Node of the light tree (host/render/light_tree.h), 208 bytes: four slots, each a child node
+ * or one light, with the bounds of the lights below it for the importance of
+ * kernels/lights/light_tree.cl (Conty Estevez & Kulla 2018; pbrt-v4's LightBounds), laid out as one
+ * float4 per quantity so that the four importances are one vector computation. nodes[0] is the
+ * root. Per slot k (the vectors' component k):
  * x, y, z: centre of the box of the lights' vertices; radius: of the box's bounding sphere about
  * it, rounded up. ax, ay, az: unit axis w of the cone of emitting normals; cos_o: cos θ_o, its
  * half-angle, rounded down, sin_o its sine rounded up; cos_e: cos θ_e, how far beyond the normals
- * a light emits (π/2 for area lights: 0), rounded down. phi: power φ, 0 for an empty slot. */
+ * a light emits (π/2 for area lights: 0), rounded down. phi: power φ, 0 for an empty slot.
+ * child[k]: the child node's index, or the light's where bit k of flags is set
+ * (LIGHT_SLOT_LEAF << k); LIGHT_SLOT_TWO_SIDED << k: some light below emits both ways. */
 typedef struct {
     float4 x, y, z;
     float4 radius;
@@ -228,30 +231,22 @@ typedef struct {
     float4 sin_o;
     float4 cos_e;
     float4 phi;
-} LightSlots;
-
-/* Node of the light tree (host/lights/light_tree.h), 400 bytes: eight slots, each a child node
- * or one light, slot k in group[k / 4] at component k % 4. nodes[0] is the root.
- * child[k]: the child node's index, or the light's where bit k of flags is set
- * (LIGHT_SLOT_LEAF << k); LIGHT_SLOT_TWO_SIDED << k: some light below emits both ways. */
-typedef struct {
-    LightSlots group[2];
-    uint child[8];
+    uint child[4];
     uint flags;
     uint pad0, pad1, pad2;
 } LightTreeNode;
 
-#define LIGHT_TREE_WIDTH 8
-#define LIGHT_SLOT_LEAF 1u          /* << slot */
-#define LIGHT_SLOT_TWO_SIDED 256u   /* << slot */
+#define LIGHT_TREE_WIDTH 4
+#define LIGHT_SLOT_LEAF 1u        /* << slot */
+#define LIGHT_SLOT_TWO_SIDED 16u  /* << slot */
 
 /* Longest root-to-leaf path of the light tree, in levels of nodes: a light's path is a trail of
- * three bits per level (LightTreePath), the builder switching to median splits before a path
+ * two bits per level (LightTreePath), the builder switching to median splits before a path
  * could grow longer. */
-#define MCRT_LIGHT_TREE_MAX_DEPTH 10
+#define MCRT_LIGHT_TREE_MAX_DEPTH 16
 
 /* A light's path from the light tree's root to its slot, 8 bytes, one per light after the
- * tree's nodes in the tree's buffer: bits 3d to 3d + 2 of `bits` the slot taken at depth d;
+ * tree's nodes in the tree's buffer: bits 2d, 2d + 1 of `bits` the slot taken at depth d;
  * `length` its number of nodes, 0 for a light not in the tree (no power).
  * The twins of the tree's choice (light_tree_pmf) walk it. */
 typedef struct {
@@ -470,12 +465,12 @@ enum RenderArgument {
     TYPE(LightTreePath, 8, 4) FIELD(LightTreePath, bits, 0) FIELD(LightTreePath, length, 4)     \
     TYPE(AliasEntry, 16, 4) FIELD(AliasEntry, threshold, 0) FIELD(AliasEntry, alias, 4)         \
     FIELD(AliasEntry, pmf, 8)                                                                   \
-    TYPE(LightSlots, 176, 16) FIELD(LightSlots, x, 0) FIELD(LightSlots, y, 16)                 \
-    FIELD(LightSlots, z, 32) FIELD(LightSlots, radius, 48) FIELD(LightSlots, ax, 64)            \
-    FIELD(LightSlots, ay, 80) FIELD(LightSlots, az, 96) FIELD(LightSlots, cos_o, 112)           \
-    FIELD(LightSlots, sin_o, 128) FIELD(LightSlots, cos_e, 144) FIELD(LightSlots, phi, 160)     \
-    TYPE(LightTreeNode, 400, 16) FIELD(LightTreeNode, group, 0)                                  \
-    FIELD(LightTreeNode, child, 352) FIELD(LightTreeNode, flags, 384)                           \
+    TYPE(LightTreeNode, 208, 16) FIELD(LightTreeNode, x, 0) FIELD(LightTreeNode, y, 16)       \
+    FIELD(LightTreeNode, z, 32) FIELD(LightTreeNode, radius, 48) FIELD(LightTreeNode, ax, 64)   \
+    FIELD(LightTreeNode, ay, 80) FIELD(LightTreeNode, az, 96) FIELD(LightTreeNode, cos_o, 112)  \
+    FIELD(LightTreeNode, sin_o, 128) FIELD(LightTreeNode, cos_e, 144)                           \
+    FIELD(LightTreeNode, phi, 160) FIELD(LightTreeNode, child, 176)                             \
+    FIELD(LightTreeNode, flags, 192)                                                            \
     TYPE(CameraGpu, 64, 16) FIELD(CameraGpu, eye, 0) FIELD(CameraGpu, right, 16)                \
     FIELD(CameraGpu, up, 32) FIELD(CameraGpu, forward, 48)                                      \
     TYPE(RenderParams, 96, 16) FIELD(RenderParams, sky, 0) FIELD(RenderParams, ao_distance, 16) \

@@ -1,6 +1,6 @@
-/* Choosing a light by walking the light tree (host/lights/light_tree.h) from the root: at each
- * node one of its eight slots by the slots' importance at the shading point, from one number
- * rescaled at every level (Conty Estevez & Kulla 2018; pbrt-v4's BVHLightSampler, eight wide),
+/* Choosing a light by walking the light tree (host/render/light_tree.h) from the root: at each
+ * node one of its four slots by the slots' importance at the shading point, from one number
+ * rescaled at every level (Conty Estevez & Kulla 2018; pbrt-v4's BVHLightSampler, four wide),
  * and the pmf of a given light by walking its stored path with the same arithmetic. */
 #ifndef MCRT_LIGHT_TREE_CL
 #define MCRT_LIGHT_TREE_CL
@@ -8,15 +8,14 @@
 #include "discrete.cl"
 #include "shared_types.h"
 
-/* Importance of four slots of a node at the shading point p with unit normal n (on the side the
+/* Importance of a node's four slots at the shading point p with unit normal n (on the side the
  * light must reach), one vector component each: φ · cosθ'_light · cosθ'_receiver / d², where
  * the primes are the least angles that the slot's bounding sphere and cone allow (Conty Estevez
  * & Kulla 2018, eq. 3; pbrt-v4 LightBounds::Importance), every angle held as its cosine and sine
  * (pbrt-v4's cosSubClamped / sinSubClamped): no trigonometry. 0 where no light below can reach
  * p's hemisphere, or for an empty slot (φ = 0, cos θ_e = 1). The receiver's bound is one-sided
  * because every BSDF here reflects only (a transmissive one would take |cos|). */
-inline float4 light_slot_importance(global const LightSlots* node, uint two_sided_bits,
-                                    float3 p, float3 n) {
+inline float4 light_slot_importance(global const LightTreeNode* node, float3 p, float3 n) {
     const float4 zero = (float4)(0.0f), one = (float4)(1.0f);
     float4 dx = p.x - node->x, dy = p.y - node->y, dz = p.z - node->z; /* centre → p */
     float4 d2 = dx * dx + dy * dy + dz * dz;
@@ -38,7 +37,9 @@ inline float4 light_slot_importance(global const LightSlots* node, uint two_side
     float4 beside_sphere = sqrt(max(zero, d2 - r2));
 
     /* θ_w: between the cone's axis and the direction to p; either way for two-sided lights. */
-    int4 two_sided = ((uint4)(two_sided_bits) & (uint4)(1u, 2u, 4u, 8u)) != (uint4)(0u);
+    int4 two_sided = ((uint4)(node->flags) & (uint4)(LIGHT_SLOT_TWO_SIDED, LIGHT_SLOT_TWO_SIDED << 1,
+                                                     LIGHT_SLOT_TWO_SIDED << 2,
+                                                     LIGHT_SLOT_TWO_SIDED << 3)) != (uint4)(0u);
     along_axis = select(along_axis, fabs(along_axis), two_sided);
     float4 cos_w = select(one, along_axis * inv_d, apart);
     float4 sin_w = across_axis * inv_d;
@@ -61,35 +62,27 @@ inline float4 light_slot_importance(global const LightSlots* node, uint two_side
     return select(importance, zero, (cos_p <= node->cos_e) | (cos_pi <= zero));
 }
 
-/* The probabilities of a node's eight slots at (p, n), slots 0-3 in lo, 4-7 in hi: the one
- * computation the sampler and the pmf share, so that both multiply the very same floats. The
- * two halves' importances are independent chains, which a CPU overlaps. A slot's bounds are
- * tighter than its parent's, so all eight may have no importance where the parent had some:
- * they are then weighed by power alone (none can light p, so the choice only needs to be some
- * choice), and the pmfs of all lights sum to 1 wherever the root's slots have importance. False
- * at the root when no light can reach p, and anywhere for a non-finite importance. */
+/* The probabilities of a node's four slots at (p, n): the one computation the sampler and the
+ * pmf share, so that both multiply the very same floats. A slot's bounds are tighter than its
+ * parent's, so all four may have no importance where the parent had some: they are then weighed
+ * by power alone (none can light p, so the choice only needs to be some choice), and the pmfs of
+ * all lights sum to 1 wherever the root's slots have importance. False at the root when no
+ * light can reach p, and anywhere for a non-finite importance. */
 inline bool light_tree_shares(global const LightTreeNode* node, float3 p, float3 n, bool root,
-                              float4* lo, float4* hi) {
-    uint two_sided = node->flags / LIGHT_SLOT_TWO_SIDED;
-    float4 a = light_slot_importance(&node->group[0], two_sided, p, n);
-    float4 b = light_slot_importance(&node->group[1], two_sided >> 4, p, n);
-    float sum = ((a.x + a.y) + (a.z + a.w)) + ((b.x + b.y) + (b.z + b.w));
+                              float4* share) {
+    float4 importance = light_slot_importance(node, p, n);
+    float sum = (importance.x + importance.y) + (importance.z + importance.w);
     if (sum == 0.0f && !root) {
-        a = node->group[0].phi;
-        b = node->group[1].phi;
-        sum = ((a.x + a.y) + (a.z + a.w)) + ((b.x + b.y) + (b.z + b.w));
+        importance = node->phi;
+        sum = (importance.x + importance.y) + (importance.z + importance.w);
     }
     if (!(sum > 0.0f) || !isfinite(sum)) return false;
-    *lo = a / sum;
-    *hi = b / sum;
+    *share = importance / sum;
     return true;
 }
 
-/* The share of slot `slot` (0-7), by a select and a shuffle rather than branches. */
-inline float light_slot_share(float4 lo, float4 hi, uint slot) {
-    float4 group = slot < 4u ? lo : hi;
-    return shuffle(group, (uint4)(slot & 3u)).x;
-}
+/* Component `slot` of share, by a shuffle rather than a branch on the slot. */
+inline float light_slot_share(float4 share, uint slot) { return shuffle(share, (uint4)(slot)).x; }
 
 /* Where [lo, hi) is cut between a part of share a (below) and one of share b (above), both
  * taken of the node's span: the smaller share's width is computed directly, so that both keep
@@ -161,31 +154,22 @@ inline DiscreteSample sample_light_tree(global const LightTreeNode* nodes,
     float pmf = 1.0f;
     for (uint depth = 0u; depth < MCRT_LIGHT_TREE_MAX_DEPTH; ++depth) {
         light_tree_prefetch_below(nodes, node, lights, light_count);
-        float4 lo_share, hi_share;
-        if (!light_tree_shares(node, p, n, depth == 0u, &lo_share, &hi_share)) return s;
+        float4 share;
+        if (!light_tree_shares(node, p, n, depth == 0u, &share)) return s;
         float span = (float)(long)range;
-        /* The halves' cut, both halves' cuts between their pairs, then within the half x
-         * falls in the cuts of its two pairs: no branch between dependent steps. */
-        float4 pairs = (float4)(lo_share.x + lo_share.y, lo_share.z + lo_share.w,
-                                hi_share.x + hi_share.y, hi_share.z + hi_share.w);
-        ulong middle = light_tree_cut(0ul, range, pairs.x + pairs.y, pairs.z + pairs.w, span);
-        ulong lo_cut = light_tree_cut(0ul, middle, pairs.x, pairs.y, span);
-        ulong hi_cut = light_tree_cut(middle, range, pairs.z, pairs.w, span);
-        bool first_half = x < middle;
-        float4 share = first_half ? lo_share : hi_share;
-        ulong begin = first_half ? 0ul : middle, end = first_half ? middle : range;
-        ulong quarter = first_half ? lo_cut : hi_cut;
-        ulong left = light_tree_cut(begin, quarter, share.x, share.y, span);
-        ulong right = light_tree_cut(quarter, end, share.z, share.w, span);
-        bool first_pair = x < quarter;
+        ulong middle = light_tree_cut(0ul, range, share.x + share.y, share.z + share.w, span);
+        /* Both pairs' cuts, then the one x needs: no branch between dependent steps. */
+        ulong left = light_tree_cut(0ul, middle, share.x, share.y, span);
+        ulong right = light_tree_cut(middle, range, share.z, share.w, span);
+        bool first_pair = x < middle;
         ulong cut = first_pair ? left : right;
         bool below = x < cut;
-        uint slot = (first_half ? 0u : 4u) + (first_pair ? 0u : 2u) + (below ? 0u : 1u);
-        ulong lo = below ? (first_pair ? begin : quarter) : cut;
-        ulong hi = below ? cut : (first_pair ? quarter : end);
+        uint slot = (first_pair ? 0u : 2u) + (below ? 0u : 1u);
+        ulong lo = below ? (first_pair ? 0ul : middle) : cut;
+        ulong hi = below ? cut : (first_pair ? middle : range);
         x -= lo;
         range = hi - lo;
-        pmf *= light_slot_share(lo_share, hi_share, slot);
+        pmf *= light_slot_share(share, slot);
         if ((node->flags & (LIGHT_SLOT_LEAF << slot)) != 0u) {
             s.index = node->child[slot];
             s.pmf = pmf;
@@ -204,10 +188,10 @@ inline float light_tree_pmf(global const LightTreeNode* nodes, uint trail, uint 
     global const LightTreeNode* node = nodes;
     float pmf = 1.0f;
     for (uint depth = 0u; depth < length; ++depth) {
-        float4 lo_share, hi_share;
-        if (!light_tree_shares(node, p, n, depth == 0u, &lo_share, &hi_share)) return 0.0f;
-        uint slot = (trail >> (3u * depth)) & 7u;
-        pmf *= light_slot_share(lo_share, hi_share, slot);
+        float4 share;
+        if (!light_tree_shares(node, p, n, depth == 0u, &share)) return 0.0f;
+        uint slot = (trail >> (2u * depth)) & 3u;
+        pmf *= light_slot_share(share, slot);
         if (depth + 1u < length) node = nodes + node->child[slot];
     }
     return length == 0u ? 0.0f : pmf;

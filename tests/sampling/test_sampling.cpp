@@ -937,16 +937,15 @@ TEST_CASE("light tree: every light in one slot, bounds hold what is below them",
             for (size_t d = 0; d < length; ++d) {
                 REQUIRE(node < tree.nodes.size());
                 const gpu::LightTreeNode& x = tree.nodes[node];
-                const int k = int((tree.paths[i].bits >> (3 * d)) & 7u);
-                const gpu::LightSlots& h = x.group[k / 4];
-                auto at = [k](const gpu::float4& v) { return double((&v.x)[k % 4]); };
-                const dvec3 centre(at(h.x), at(h.y), at(h.z));
-                for (const dvec3& v : {p0, p1, p2}) CHECK(glm::length(v - centre) <= at(h.radius));
-                dvec3 axis(at(h.ax), at(h.ay), at(h.az));
-                CHECK(glm::dot(axis, normal) >= at(h.cos_o) - 1e-6);
-                CHECK(at(h.sin_o) >= std::sqrt(std::max(0.0, 1 - at(h.cos_o) * at(h.cos_o))));
-                CHECK(at(h.cos_e) <= 0.0);
-                CHECK(at(h.phi) >= 0.999 * t.powers[i]);
+                const int k = int((tree.paths[i].bits >> (2 * d)) & 3u);
+                auto at = [k](const gpu::float4& v) { return double((&v.x)[k]); };
+                const dvec3 centre(at(x.x), at(x.y), at(x.z));
+                for (const dvec3& v : {p0, p1, p2}) CHECK(glm::length(v - centre) <= at(x.radius));
+                dvec3 axis(at(x.ax), at(x.ay), at(x.az));
+                CHECK(glm::dot(axis, normal) >= at(x.cos_o) - 1e-6);
+                CHECK(at(x.sin_o) >= std::sqrt(std::max(0.0, 1 - at(x.cos_o) * at(x.cos_o))));
+                CHECK(at(x.cos_e) <= 0.0);
+                CHECK(at(x.phi) >= 0.999 * t.powers[i]);
                 if ((l.flags & MATERIAL_DOUBLE_SIDED) != 0)
                     CHECK((x.flags & (LIGHT_SLOT_TWO_SIDED << k)) != 0);
                 if (d + 1 == length) {
@@ -963,17 +962,14 @@ TEST_CASE("light tree: every light in one slot, bounds hold what is below them",
         // Every slot: a light, a node or empty (no power); as many light slots as lights.
         size_t light_slots = 0;
         for (const gpu::LightTreeNode& x : tree.nodes)
-            for (int k = 0; k < LIGHT_TREE_WIDTH; ++k) {
-                const gpu::LightSlots& h = x.group[k / 4];
+            for (int k = 0; k < 4; ++k) {
                 if ((x.flags & (LIGHT_SLOT_LEAF << k)) != 0) ++light_slots;
-                if ((&h.phi.x)[k % 4] == 0.0f) CHECK((&h.cos_e.x)[k % 4] == 1.0f);
+                if ((&x.phi.x)[k] == 0.0f) CHECK((&x.cos_e.x)[k] == 1.0f);
             }
         CHECK(light_slots == in_tree);
         // The root's slots hold the power of all.
-        double root_phi = 0.0;
-        for (const gpu::LightSlots& h : tree.nodes[0].group)
-            root_phi += double(h.phi.x) + h.phi.y + h.phi.z + h.phi.w;
-        CHECK(root_phi ==
+        const gpu::float4& phi = tree.nodes[0].phi;
+        CHECK(double(phi.x) + phi.y + phi.z + phi.w ==
               Approx(std::accumulate(t.powers.begin(), t.powers.end(), 0.0)).epsilon(1e-5));
         if (c.n == 0) CHECK(max_length <= MCRT_LIGHT_TREE_MAX_DEPTH);  // the chain stays within it
         std::printf("light tree of %zu lights: %zu nodes, longest path %zu nodes\n", in_tree,
