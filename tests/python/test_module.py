@@ -73,8 +73,14 @@ def test_every_estimator_gives_the_cli_bytes(cornell, tmp_path, estimator):
         cli_render(tmp_path, estimator, *args)
 
 
-@pytest.mark.parametrize("light_select,sampler", [("uniform", "sobol"), ("alias", "stratified"),
-                                                  ("tree", "independent"), ("power", "sobol")])
+# Every light selection of the table, each with the samplers in turn (a selection added to the
+# table is tested here without an edit).
+SELECTIONS = [s["name"] for s in mcrt.variants()["light_select"]]
+SAMPLERS = [s["name"] for s in mcrt.variants()["samplers"]]
+SELECTION_SAMPLERS = [(s, SAMPLERS[(k + 2) % len(SAMPLERS)]) for k, s in enumerate(SELECTIONS)]
+
+
+@pytest.mark.parametrize("light_select,sampler", SELECTION_SAMPLERS)
 def test_light_selections_and_samplers_give_the_cli_bytes(cornell, tmp_path, light_select,
                                                           sampler):
     # One scene rendered under several selections in turn: each keeps its own device data.

@@ -63,7 +63,7 @@ TEST_CASE("Sobol's variance x spp keeps falling on a light made of two triangles
     settings.height = 32;
     settings.estimator = "light-area";
     settings.sampler = "sobol";
-    for (const char* select : {"power", "uniform", "alias"}) {
+    for (const std::string& select : variant_names(kLightSelectVariants)) {
         settings.light_select = select;
         double fall[2];
         for (int triangles : {2, 1}) {
