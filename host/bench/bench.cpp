@@ -287,7 +287,6 @@ int run_bench(const BenchOptions& o, const std::function<void(const std::string&
                 {"bvh_depth", bvh.stats.depth4},
                 {"bvh_nodes", bvh.nodes4.size()},
                 {"bvh_packets", bvh.stats.packets},
-                {"bvh_references", bvh.stats.references},
                 {"bytes_per_triangle", bytes_per_triangle},
             };
 #ifdef MCRT_HAVE_EMBREE
@@ -316,10 +315,10 @@ int run_bench(const BenchOptions& o, const std::function<void(const std::string&
                                         : "its first",
                 o.width, o.height, o.device, tracer.info().name.c_str());
     std::printf(
-        "mcrt BVH4: built in %.3f s, SAH cost %.2f, depth %d, %zu nodes, %zu packets, %zu "
-        "references, %.1f bytes per triangle\n",
+        "mcrt BVH4: built in %.3f s, SAH cost %.2f, depth %d, %zu nodes, %zu packets, %.1f bytes "
+        "per triangle\n",
         bvh.stats.build_seconds, bvh.stats.sah_cost4, bvh.stats.depth4, bvh.nodes4.size(),
-        bvh.stats.packets, bvh.stats.references, bytes_per_triangle);
+        bvh.stats.packets, bytes_per_triangle);
 #ifdef MCRT_HAVE_EMBREE
     std::printf("Embree %s: built in %.3f s (default quality), %u threads, single-ray API\n",
                 embree.version().c_str(), embree.build_seconds(), embree.threads());

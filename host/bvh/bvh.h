@@ -25,9 +25,6 @@ struct BvhBuildOptions {
     // SAH cost of visiting an inner node, relative to testing one TrianglePacket (up to 4
     // triangles at once: a leaf of N triangles costs ceil(N / 4), as in Embree's SAH).
     float traversal_cost = 1.0f;
-    // Spatial splits (Stich et al. 2009): 0 builds over whole triangles; above 0, triangles may
-    // be split into references until there are (1 + budget) times as many as triangles.
-    float spatial_split_budget = 0.0f;
 };
 
 struct BvhStats {
@@ -35,9 +32,8 @@ struct BvhStats {
     double sah_cost = 0;  // expected cost per ray, in packet tests (PBRT 4.3.2)
     int depth = 0;        // nodes on the longest root-to-leaf path, ≤ kMaxBvhDepth
     size_t inner_nodes = 0, leaves = 0;
-    size_t references = 0;  // leaf entries: the triangles, plus the pieces of spatial splits
-    size_t packets = 0;     // TrianglePackets (ceil(N / 4) per leaf of N triangles)
-    size_t bytes = 0;       // what the device holds: 4-wide nodes, packets, a TriangleInfo per lane
+    size_t packets = 0;  // TrianglePackets (ceil(N / 4) per leaf of N triangles)
+    size_t bytes = 0;    // what the device holds: 4-wide nodes, packets, a TriangleInfo per lane
     double collapse_seconds = 0;  // of build_seconds, the BVH2 → BVH4 collapse and packing
     int depth4 = 0;               // Bvh4Nodes on the longest root-to-leaf path, ≤ kMaxBvh4Depth
     double sah_cost4 = 0;         // SAH cost of the 4-wide tree (a node visit costs traversal_cost)

@@ -128,8 +128,7 @@ class Builder {
         : scene_(scene),
           bins_(options.bins),
           max_leaf_(uint32_t(options.max_leaf_size)),
-          traversal_cost_(options.traversal_cost),
-          split_budget_(options.spatial_split_budget) {}
+          traversal_cost_(options.traversal_cost) {}
 
     Bvh build();
 
@@ -139,30 +138,16 @@ class Builder {
                        uint32_t defer_at_most, std::vector<Task>* deferred);
     std::vector<gpu::BvhNode> build_parallel(const Task& root, const gpu::BvhNode& root_node,
                                              unsigned threads, int& depth);
-    SahSplit find_sah_split(const PrimRef* refs, const Task& task, Scratch& scratch);
-    uint32_t partition_sah(PrimRef* refs, uint32_t* ids, const Task& task, const SahSplit& split,
-                           Bounds child_box[2], Bounds child_cbox[2]);
-    // Spatial splits (Stich, Friedrich, Dietrich 2009, "Spatial splits in bounding volume
-    // hierarchies"): the tree over references, a triangle's clipped pieces, laid out as
-    // build_subtree lays out its nodes; refs_ and ids_ end in leaf order.
-    void build_spatial(const gpu::BvhNode& root_node, const Bounds& root_cbox,
-                       std::vector<gpu::BvhNode>& nodes, int& depth);
-    void build_spatial_node(std::vector<PrimRef>& refs, std::vector<uint32_t>& ids, uint32_t node,
-                            int level, const Bounds& cbox, std::vector<gpu::BvhNode>& nodes,
-                            Scratch& scratch, std::vector<PrimRef>& out_refs,
-                            std::vector<uint32_t>& out_ids, int& depth);
-    Bounds clipped(uint32_t id, const PrimRef& ref, int axis, float lo, float hi) const;
-    uint32_t partition_median(PrimRef* refs, uint32_t* ids, const Task& task, Bounds child_box[2],
-                              Bounds child_cbox[2]);
+    SahSplit find_sah_split(const Task& task, Scratch& scratch);
+    uint32_t partition_sah(const Task& task, const SahSplit& split, Bounds child_box[2],
+                           Bounds child_cbox[2]);
+    uint32_t partition_median(const Task& task, Bounds child_box[2], Bounds child_cbox[2]);
     void fill_stats(Bvh& bvh, int depth) const;
 
     const Scene& scene_;
     int bins_;
     uint32_t max_leaf_;
     float traversal_cost_;
-    float split_budget_;         // extra references allowed, as a fraction of the triangles
-    size_t extra_refs_ = 0;      // references added by spatial splits so far
-    double root_area_ = 0.0;     // the root box's area, for the overlap test
     std::vector<PrimRef> refs_;  // threads own disjoint ranges of refs_ and ids_
     std::vector<uint32_t> ids_;  // scene triangle of refs_[i], permuted alongside
 };
@@ -209,7 +194,7 @@ Bounds Builder::make_refs() {
 
 // Bins the centroids of the task on all three axes and sweeps for the cheapest plane (Wald 2007
 // §3).
-SahSplit Builder::find_sah_split(const PrimRef* refs, const Task& task, Scratch& scratch) {
+SahSplit Builder::find_sah_split(const Task& task, Scratch& scratch) {
     SahSplit best;
     for (int k = 0; k < 3; ++k) {
         float extent = task.cbox.hi[k] - task.cbox.lo[k];
@@ -227,7 +212,7 @@ SahSplit Builder::find_sah_split(const PrimRef* refs, const Task& task, Scratch&
     uint32_t* right_count = scratch.right_count.data();
     V4i used_lo = V4i{} + bins_, used_hi = V4i{};
     for (uint32_t i = task.begin; i < task.end; ++i) {
-        const PrimRef& r = refs[i];
+        const PrimRef& r = refs_[i];
         const V4i b = bins_of(r.centroid2(), origin, scale, last_bin);
         used_lo = b < used_lo ? b : used_lo;
         used_hi = b > used_hi ? b : used_hi;
@@ -284,24 +269,24 @@ SahSplit Builder::find_sah_split(const PrimRef* refs, const Task& task, Scratch&
 
 // Partitions refs[begin, end) in place by the plane of `split` (the binning's own bins_of, so the
 // sides match the bin counts) and bounds both sides; returns the first index on the right.
-uint32_t Builder::partition_sah(PrimRef* refs, uint32_t* ids, const Task& task,
-                                const SahSplit& split, Bounds child_box[2], Bounds child_cbox[2]) {
+uint32_t Builder::partition_sah(const Task& task, const SahSplit& split, Bounds child_box[2],
+                                Bounds child_cbox[2]) {
     const int k = split.axis;
     const V4 last_bin = V4{} + float(bins_ - 1);
     auto is_left = [&](const PrimRef& r) {
         return bins_of(r.centroid2(), task.cbox.lo, split.scale, last_bin)[k] <= split.bin;
     };
     auto add = [&](uint32_t i, int side) {
-        child_box[side].grow(refs[i].lo, refs[i].hi);
-        child_cbox[side].grow_point(refs[i].centroid2());
+        child_box[side].grow(refs_[i].lo, refs_[i].hi);
+        child_cbox[side].grow_point(refs_[i].centroid2());
     };
     uint32_t i = task.begin, j = task.end;
     for (;;) {
-        while (i < j && is_left(refs[i])) add(i++, 0);
-        while (i < j && !is_left(refs[j - 1])) add(--j, 1);
+        while (i < j && is_left(refs_[i])) add(i++, 0);
+        while (i < j && !is_left(refs_[j - 1])) add(--j, 1);
         if (i >= j) break;
-        std::swap(refs[i], refs[j - 1]);
-        std::swap(ids[i], ids[j - 1]);
+        std::swap(refs_[i], refs_[j - 1]);
+        std::swap(ids_[i], ids_[j - 1]);
         add(i++, 0);
         add(--j, 1);
     }
@@ -310,8 +295,7 @@ uint32_t Builder::partition_sah(PrimRef* refs, uint32_t* ids, const Task& task,
 
 // Splits refs[begin, end) at the middle index, ordered along the widest centroid axis (object
 // median).
-uint32_t Builder::partition_median(PrimRef* refs, uint32_t* ids, const Task& task,
-                                   Bounds child_box[2], Bounds child_cbox[2]) {
+uint32_t Builder::partition_median(const Task& task, Bounds child_box[2], Bounds child_cbox[2]) {
     int k = 0;
     for (int a = 1; a < 3; ++a)
         if (task.cbox.hi[a] - task.cbox.lo[a] > task.cbox.hi[k] - task.cbox.lo[k]) k = a;
@@ -322,20 +306,20 @@ uint32_t Builder::partition_median(PrimRef* refs, uint32_t* ids, const Task& tas
         for (uint32_t i = 0; i < order.size(); ++i) order[i] = task.begin + i;
         std::nth_element(order.begin(), order.begin() + (mid - task.begin), order.end(),
                          [&](uint32_t a, uint32_t b) {
-                             return refs[a].centroid2()[k] < refs[b].centroid2()[k];
+                             return refs_[a].centroid2()[k] < refs_[b].centroid2()[k];
                          });
-        std::vector<PrimRef> sorted_refs(order.size());
-        std::vector<uint32_t> sorted_ids(order.size());
+        std::vector<PrimRef> refs(order.size());
+        std::vector<uint32_t> ids(order.size());
         for (size_t i = 0; i < order.size(); ++i)
-            sorted_refs[i] = refs[order[i]], sorted_ids[i] = ids[order[i]];
-        std::copy(sorted_refs.begin(), sorted_refs.end(), refs + task.begin);
-        std::copy(sorted_ids.begin(), sorted_ids.end(), ids + task.begin);
+            refs[i] = refs_[order[i]], ids[i] = ids_[order[i]];
+        std::copy(refs.begin(), refs.end(), refs_.begin() + task.begin);
+        std::copy(ids.begin(), ids.end(), ids_.begin() + task.begin);
     }
     for (int side = 0; side < 2; ++side) child_box[side] = child_cbox[side] = Bounds{};
     for (uint32_t i = task.begin; i < task.end; ++i) {
         const int side = i < mid ? 0 : 1;
-        child_box[side].grow(refs[i].lo, refs[i].hi);
-        child_cbox[side].grow_point(refs[i].centroid2());
+        child_box[side].grow(refs_[i].lo, refs_[i].hi);
+        child_cbox[side].grow_point(refs_[i].centroid2());
     }
     return mid;
 }
@@ -362,7 +346,7 @@ void Builder::build_subtree(Task root, std::vector<gpu::BvhNode>& nodes, Scratch
             // Leaf when it costs no more than the best split (PBRT 4.3.2); never above
             // max_leaf_size.
             const double area = node_box(nodes[task.node]).area();
-            split = find_sah_split(refs_.data(), task, scratch);
+            split = find_sah_split(task, scratch);
             leaf = count <= max_leaf_ &&
                    (split.axis < 0 ||
                     double(packets_for(count)) * area <= traversal_cost_ * area + split.cost);
@@ -375,12 +359,11 @@ void Builder::build_subtree(Task root, std::vector<gpu::BvhNode>& nodes, Scratch
 
         Bounds child_box[2], child_cbox[2];
         uint32_t mid = task.end;
-        if (split.axis >= 0)
-            mid = partition_sah(refs_.data(), ids_.data(), task, split, child_box, child_cbox);
+        if (split.axis >= 0) mid = partition_sah(task, split, child_box, child_cbox);
         // Coincident centroids, or an SAH split too lopsided for the depth left: median split.
         const uint32_t larger = std::max(mid - task.begin, task.end - mid);
         if (mid == task.begin || mid == task.end || levels_needed(larger, max_leaf_) > budget)
-            mid = partition_median(refs_.data(), ids_.data(), task, child_box, child_cbox);
+            mid = partition_median(task, child_box, child_cbox);
 
         const uint32_t left = uint32_t(nodes.size());
         set_first_count(nodes[task.node], left, 0);
@@ -478,247 +461,6 @@ std::vector<gpu::BvhNode> Builder::build_parallel(const Task& root, const gpu::B
     return nodes;
 }
 
-// The bounds of triangle `id` clipped to the slab lo ≤ x[axis] ≤ hi, within the reference's own
-// bounds (a piece of an earlier split): the vertices inside the slab and the points where the
-// edges cross its planes (Stich et al. 2009, sec. 4.2). Empty (inverted) when nothing is left.
-Bounds Builder::clipped(uint32_t id, const PrimRef& ref, int axis, float lo, float hi) const {
-    const glm::vec3* p = &scene_.positions[3 * size_t(id)];
-    Bounds b;
-    for (int e = 0; e < 3; ++e) {
-        const glm::vec3 u = p[e], v = p[(e + 1) % 3];
-        const float a = u[axis], c = v[axis];
-        if (a >= lo && a <= hi) b.grow_point(V4{u.x, u.y, u.z, 0.0f});
-        for (float plane : {lo, hi}) {
-            if ((a < plane && c > plane) || (a > plane && c < plane)) {
-                const float t = (plane - a) / (c - a);
-                glm::vec3 x = u + (v - u) * t;
-                x[axis] = plane;
-                b.grow_point(V4{x.x, x.y, x.z, 0.0f});
-            }
-        }
-    }
-    b.lo = vmax(b.lo, ref.lo);
-    b.hi = vmin(b.hi, ref.hi);
-    b.lo[axis] = std::max(b.lo[axis], lo);
-    b.hi[axis] = std::min(b.hi[axis], hi);
-    for (int k = 0; k < 3; ++k)
-        if (!(b.lo[k] <= b.hi[k])) return Bounds{};
-    return b;
-}
-
-namespace {
-bool is_empty(const Bounds& b) { return !(b.lo[0] <= b.hi[0]); }
-Bounds overlap(const Bounds& a, const Bounds& b) {
-    Bounds o;
-    o.lo = vmax(a.lo, b.lo);
-    o.hi = vmin(a.hi, b.hi);
-    return o;
-}
-Bounds merged(Bounds a, const Bounds& b) {
-    a.grow(b);
-    return a;
-}
-}  // namespace
-
-void Builder::build_spatial_node(std::vector<PrimRef>& refs, std::vector<uint32_t>& ids,
-                                 uint32_t node, int level, const Bounds& cbox,
-                                 std::vector<gpu::BvhNode>& nodes, Scratch& scratch,
-                                 std::vector<PrimRef>& out_refs, std::vector<uint32_t>& out_ids,
-                                 int& depth) {
-    const uint32_t count = uint32_t(refs.size());
-    const int budget = kMaxBvhDepth - level;
-    const Bounds box = node_box(nodes[node]);
-    const double area = box.area();
-    Task task{0, count, node, level, cbox};
-    bool leaf = count <= 1 || budget <= 0;
-    SahSplit split;
-    Bounds child_box[2], child_cbox[2];
-    uint32_t mid = count;
-    // The spatial split, when it wins: the plane and its side's references.
-    std::vector<PrimRef> side_refs[2];
-    std::vector<uint32_t> side_ids[2];
-    bool spatial = false;
-    int spatial_axis = -1;
-    float spatial_plane = 0.0f;
-    if (!leaf) {
-        split = find_sah_split(refs.data(), task, scratch);
-        double best_cost = split.cost;
-        if (split.axis >= 0)
-            mid = partition_sah(refs.data(), ids.data(), task, split, child_box, child_cbox);
-        const double lambda =
-            split.axis >= 0 ? overlap(child_box[0], child_box[1]).area() : root_area_;
-        const size_t allowed = size_t(double(split_budget_) * double(scene_.triangle_count()));
-        // Spatial splits only where the object split's children overlap (Stich et al. sec. 4.3,
-        // α = 1e-5) and while the reference budget lasts.
-        if (lambda > 1e-5 * root_area_ && extra_refs_ < allowed) {
-            const int bins = bins_;
-            for (int k = 0; k < 3; ++k) {
-                const float lo = box.lo[k], extent = box.hi[k] - lo;
-                if (!(extent > 0.0f)) continue;
-                const float scale = float(bins) / extent;
-                std::vector<Bounds> bin_box(static_cast<size_t>(bins));
-                std::vector<uint32_t> entry(static_cast<size_t>(bins)),
-                    exit(static_cast<size_t>(bins));
-                auto bin_of = [&](float x) {
-                    return std::min(bins - 1, std::max(0, int((x - lo) * scale)));
-                };
-                auto plane = [&](int i) { return lo + float(i) * extent / float(bins); };
-                for (uint32_t i = 0; i < count; ++i) {
-                    const PrimRef& r = refs[i];
-                    const int first = bin_of(r.lo[k]), last = bin_of(r.hi[k]);
-                    ++entry[size_t(first)];
-                    ++exit[size_t(last)];
-                    if (first == last) {
-                        bin_box[size_t(first)].grow(r.lo, r.hi);
-                        continue;
-                    }
-                    for (int b = first; b <= last; ++b)
-                        bin_box[size_t(b)].grow(clipped(ids[i], r, k, plane(b), plane(b + 1)));
-                }
-                std::vector<double> right_area(static_cast<size_t>(bins));
-                std::vector<uint32_t> right_count(static_cast<size_t>(bins));
-                Bounds acc;
-                uint32_t n = 0;
-                for (int i = bins - 1; i > 0; --i) {
-                    acc.grow(bin_box[size_t(i)]);
-                    n += exit[size_t(i)];
-                    right_area[size_t(i - 1)] = acc.area();
-                    right_count[size_t(i - 1)] = n;
-                }
-                acc = Bounds{};
-                n = 0;
-                for (int i = 0; i < bins - 1; ++i) {
-                    acc.grow(bin_box[size_t(i)]);
-                    n += entry[size_t(i)];
-                    if (n == 0 || right_count[size_t(i)] == 0) continue;
-                    const double cost = acc.area() * packets_for(n) +
-                                        right_area[size_t(i)] * packets_for(right_count[size_t(i)]);
-                    if (cost < best_cost) {
-                        best_cost = cost;
-                        spatial = true;
-                        spatial_axis = k;
-                        spatial_plane = plane(i + 1);
-                    }
-                }
-            }
-        }
-        leaf = count <= max_leaf_ &&
-               ((split.axis < 0 && !spatial) ||
-                double(packets_for(count)) * area <= traversal_cost_ * area + best_cost);
-    }
-    if (!leaf && spatial) {
-        // References wholly on one side go there; the others are split at the plane, or kept
-        // whole on one side where that costs less (reference unsplitting, Stich et al. 4.4).
-        const int k = spatial_axis;
-        const float x = spatial_plane;
-        Bounds side_box[2];
-        std::vector<uint32_t> straddling;
-        for (uint32_t i = 0; i < count; ++i) {
-            const PrimRef& r = refs[i];
-            if (r.hi[k] <= x) {
-                side_refs[0].push_back(r), side_ids[0].push_back(ids[i]);
-                side_box[0].grow(r.lo, r.hi);
-            } else if (r.lo[k] >= x) {
-                side_refs[1].push_back(r), side_ids[1].push_back(ids[i]);
-                side_box[1].grow(r.lo, r.hi);
-            } else {
-                straddling.push_back(i);
-            }
-        }
-        // Boxes and counts as if every straddling reference were split.
-        std::vector<Bounds> pieces[2];
-        for (uint32_t i : straddling) {
-            pieces[0].push_back(clipped(ids[i], refs[i], k, -kInf, x));
-            pieces[1].push_back(clipped(ids[i], refs[i], k, x, kInf));
-        }
-        Bounds all_box[2] = {side_box[0], side_box[1]};
-        uint32_t n[2] = {uint32_t(side_refs[0].size()), uint32_t(side_refs[1].size())};
-        for (size_t j = 0; j < straddling.size(); ++j)
-            for (int side = 0; side < 2; ++side)
-                if (!is_empty(pieces[side][j])) all_box[side].grow(pieces[side][j]), ++n[side];
-        for (size_t j = 0; j < straddling.size(); ++j) {
-            const uint32_t i = straddling[j];
-            const PrimRef& r = refs[i];
-            Bounds whole;
-            whole.grow(r.lo, r.hi);
-            const double c_split =
-                all_box[0].area() * packets_for(n[0]) + all_box[1].area() * packets_for(n[1]);
-            const double c_left = merged(all_box[0], whole).area() * packets_for(n[0]) +
-                                  all_box[1].area() * packets_for(n[1] - 1);
-            const double c_right = all_box[0].area() * packets_for(n[0] - 1) +
-                                   merged(all_box[1], whole).area() * packets_for(n[1]);
-            const bool empty0 = is_empty(pieces[0][j]), empty1 = is_empty(pieces[1][j]);
-            if (empty0 || empty1 || c_left < c_split || c_right < c_split) {
-                const int side = empty1 ? 0 : empty0 ? 1 : c_left <= c_right ? 0 : 1;
-                side_refs[side].push_back(r), side_ids[side].push_back(ids[i]);
-                if (!empty0 && !empty1) {
-                    all_box[side].grow(whole);
-                    --n[1 - side];
-                }
-            } else {
-                for (int side = 0; side < 2; ++side) {
-                    PrimRef piece{pieces[side][j].lo, pieces[side][j].hi};
-                    side_refs[side].push_back(piece), side_ids[side].push_back(ids[i]);
-                }
-            }
-        }
-        const uint32_t nl = uint32_t(side_refs[0].size()), nr = uint32_t(side_refs[1].size());
-        if (nl == 0 || nr == 0 || nl >= count || nr >= count ||
-            levels_needed(std::max(nl, nr), max_leaf_) > budget) {
-            spatial = false;  // no progress, or too deep: the object split below instead
-            side_refs[0].clear(), side_refs[1].clear(), side_ids[0].clear(), side_ids[1].clear();
-        } else {
-            extra_refs_ += nl + nr - count;
-            for (int side = 0; side < 2; ++side) {
-                child_box[side] = child_cbox[side] = Bounds{};
-                for (const PrimRef& r : side_refs[side]) {
-                    child_box[side].grow(r.lo, r.hi);
-                    child_cbox[side].grow_point(r.centroid2());
-                }
-            }
-        }
-    }
-    if (leaf) {
-        set_first_count(nodes[node], uint32_t(out_refs.size()), count);
-        out_refs.insert(out_refs.end(), refs.begin(), refs.end());
-        out_ids.insert(out_ids.end(), ids.begin(), ids.end());
-        depth = std::max(depth, level);
-        return;
-    }
-    if (!spatial) {
-        const uint32_t larger = std::max(mid, count - mid);
-        if (mid == 0 || mid == count || levels_needed(larger, max_leaf_) > budget)
-            mid = partition_median(refs.data(), ids.data(), task, child_box, child_cbox);
-        for (int side = 0; side < 2; ++side) {
-            const uint32_t b = side == 0 ? 0 : mid, e = side == 0 ? mid : count;
-            side_refs[side].assign(refs.begin() + b, refs.begin() + e);
-            side_ids[side].assign(ids.begin() + b, ids.begin() + e);
-        }
-    }
-    refs.clear(), refs.shrink_to_fit(), ids.clear(), ids.shrink_to_fit();
-    const uint32_t left = uint32_t(nodes.size());
-    set_first_count(nodes[node], left, 0);
-    nodes.emplace_back();
-    nodes.emplace_back();
-    set_box(nodes[left], child_box[0]);
-    set_box(nodes[left + 1], child_box[1]);
-    for (int side = 0; side < 2; ++side)
-        build_spatial_node(side_refs[side], side_ids[side], left + uint32_t(side), level + 1,
-                           child_cbox[side], nodes, scratch, out_refs, out_ids, depth);
-}
-
-void Builder::build_spatial(const gpu::BvhNode& root_node, const Bounds& root_cbox,
-                            std::vector<gpu::BvhNode>& nodes, int& depth) {
-    root_area_ = node_box(root_node).area();
-    nodes.push_back(root_node);
-    std::vector<PrimRef> refs = std::move(refs_), out_refs;
-    std::vector<uint32_t> ids = std::move(ids_), out_ids;
-    Scratch scratch(bins_);
-    build_spatial_node(refs, ids, 0, 1, root_cbox, nodes, scratch, out_refs, out_ids, depth);
-    refs_ = std::move(out_refs);
-    ids_ = std::move(out_ids);
-}
-
 Bvh Builder::build() {
     const auto start = std::chrono::steady_clock::now();
     Bvh bvh;
@@ -735,9 +477,7 @@ Bvh Builder::build() {
 
     const unsigned threads = std::min(8u, std::max(1u, std::thread::hardware_concurrency()));
     int depth = 0;
-    if (split_budget_ > 0.0f && n > 0) {
-        build_spatial(root_node, root_cbox, bvh.nodes, depth);
-    } else if (threads > 1 && n >= kParallelMinTriangles) {
+    if (threads > 1 && n >= kParallelMinTriangles) {
         bvh.nodes = build_parallel(root, root_node, threads, depth);
     } else {
         bvh.nodes.reserve(n > 0 ? 2 * size_t(n) - 1 : 1);  // a binary tree with n leaves at most
@@ -747,10 +487,9 @@ Bvh Builder::build() {
         depth = scratch.depth;
     }
 
-    // Triangles in leaf order (a triangle split by spatial splits once per reference).
-    const uint32_t references = uint32_t(ids_.size());
-    bvh.triangles.resize(references);
-    for (uint32_t i = 0; i < references; ++i) {
+    // Triangles in leaf order.
+    bvh.triangles.resize(n);
+    for (uint32_t i = 0; i < n; ++i) {
         const uint32_t t = ids_[i];
         const glm::vec3* p = &scene_.positions[3 * size_t(t)];
         gpu::Triangle& tri = bvh.triangles[i];
@@ -770,7 +509,6 @@ Bvh Builder::build() {
     bvh.stats.depth4 = bvh4.depth;
     bvh.stats.sah_cost4 = bvh4.sah_cost;
     bvh.stats.packets = bvh.packets.size();
-    bvh.stats.references = bvh.triangles.size();
     bvh.stats.bytes = bvh.nodes4.size() * sizeof(gpu::Bvh4Node) +
                       bvh.packets.size() * (sizeof(gpu::TrianglePacket) +
                                             MCRT_PACKET_WIDTH * sizeof(gpu::TriangleInfo));

@@ -100,12 +100,6 @@ CLI::App* add_bench_command(CLI::App& app, BenchOptions& o, CameraOptions& look)
         ->capture_default_str()
         ->check(kFiniteFloat)
         ->check(CLI::Range(0.0f, 100.0f));
-    cmd->add_option("--bvh-spatial-splits", o.bvh.spatial_split_budget,
-                    "spatial splits: extra triangle references allowed, a fraction of the "
-                    "triangles (0: none)")
-        ->capture_default_str()
-        ->check(kFiniteFloat)
-        ->check(CLI::Range(0.0f, 4.0f));
     return cmd;
 }
 
