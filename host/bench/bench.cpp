@@ -224,12 +224,13 @@ int run_bench(const BenchOptions& o, const std::function<void(const std::string&
             r.has_embree = true;
             r.embree.seconds_median = reference.seconds_median;
             for (size_t k = 0; k < primary.size(); ++k) {
-                uint32_t leaf = gpu::as_uint(primary_hits[k].w);
-                bool mcrt_hit = leaf != MCRT_NO_HIT, embree_hit = embree_triangle[k] != MCRT_NO_HIT;
+                uint32_t triangle = gpu::as_uint(primary_hits[k].w);
+                bool mcrt_hit = triangle != MCRT_NO_HIT,
+                     embree_hit = embree_triangle[k] != MCRT_NO_HIT;
                 r.embree.hits += embree_hit;
                 if (mcrt_hit != embree_hit) {
                     ++r.hit_mismatches;
-                } else if (mcrt_hit && bvh.triangles[leaf].index != embree_triangle[k]) {
+                } else if (mcrt_hit && triangle != embree_triangle[k]) {
                     ++r.triangle_mismatches;
                     float t = primary_hits[k].x, te = embree_t[k];
                     if (std::abs(t - te) > kTieRelative * std::max(t, te))
@@ -241,7 +242,7 @@ int run_bench(const BenchOptions& o, const std::function<void(const std::string&
         if (wanted("primary")) results.push_back(r);
     }
 
-    std::vector<SurfacePoint> points = surface_points(primary, primary_hits, bvh.triangles);
+    std::vector<SurfacePoint> points = surface_points(primary, primary_hits, scene.positions);
     for (const char* kind : {"shadow", "ambient"}) {
         if (!wanted(kind)) continue;
         bool shadow = std::strcmp(kind, "shadow") == 0;

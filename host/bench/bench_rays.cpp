@@ -73,15 +73,14 @@ RayBatch primary_rays(const gpu::CameraGpu& camera, int width, int height) {
 
 std::vector<SurfacePoint> surface_points(const RayBatch& primary,
                                          const std::vector<gpu::float4>& hits,
-                                         const std::vector<gpu::Triangle>& triangles) {
+                                         const std::vector<glm::vec3>& positions) {
     std::vector<SurfacePoint> points;
     for (size_t k = 0; k < hits.size(); ++k) {
-        const uint32_t leaf = gpu::as_uint(hits[k].w);
-        if (leaf == MCRT_NO_HIT || leaf >= triangles.size()) continue;
-        const gpu::Triangle& tri = triangles[leaf];
+        const uint32_t triangle = gpu::as_uint(hits[k].w);
+        if (triangle == MCRT_NO_HIT || 3 * size_t(triangle) + 2 >= positions.size()) continue;
+        const glm::vec3* p = &positions[3 * size_t(triangle)];
         glm::vec3 o = to_vec3(primary.origins[k]), d = to_vec3(primary.directions[k]);
-        glm::vec3 n =
-            glm::cross(to_vec3(tri.p1) - to_vec3(tri.p0), to_vec3(tri.p2) - to_vec3(tri.p0));
+        glm::vec3 n = glm::cross(p[1] - p[0], p[2] - p[0]);
         float len = glm::length(n);
         n = len > 0.0f ? n / len : -d;
         if (glm::dot(n, d) > 0.0f) n = -n;  // the geometric normal facing the ray

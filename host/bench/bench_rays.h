@@ -30,11 +30,11 @@ struct SurfacePoint {
 };
 
 // Surface points of the primary rays that hit, in ray order, from trace_closest's output
-// (t, b1, b2, leaf-order triangle index as uint bits; NO_HIT on a miss) and the BVH's
-// leaf-ordered triangles.
+// (t, b1, b2, the scene's triangle index as uint bits; NO_HIT on a miss) and the scene's
+// positions (three per triangle).
 std::vector<SurfacePoint> surface_points(const RayBatch& primary,
                                          const std::vector<gpu::float4>& hits,
-                                         const std::vector<gpu::Triangle>& triangles);
+                                         const std::vector<glm::vec3>& positions);
 
 // One closest-hit ray per pixel through its centre, row-major from the top-left pixel,
 // t_max = FLT_MAX (finite: the kernels may be built with -cl-fast-relaxed-math).

@@ -182,7 +182,7 @@ std::vector<gpu::TrianglePacket> pack_leaves(std::vector<gpu::Bvh4Node>& nodes,
                         set_lane(p.v[3 * j + 1], int(i), v[j]->y);
                         set_lane(p.v[3 * j + 2], int(i), v[j]->z);
                     }
-                    p.index[i] = first + k + i;
+                    p.index[i] = t.index;
                 }
                 packets.push_back(p);
             }

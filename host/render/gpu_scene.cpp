@@ -177,9 +177,9 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
     std::vector<uint32_t> lane_of_triangle(scene.triangle_count(), MCRT_NO_HIT);
     for (size_t p = 0; p < bvh.packets.size(); ++p) {
         for (int lane = 0; lane < MCRT_PACKET_WIDTH; ++lane) {
-            const uint32_t leaf = bvh.packets[p].index[lane];
-            if (leaf == MCRT_NO_HIT) continue;
-            lane_of_triangle[bvh.triangles[leaf].index] = uint32_t(p * MCRT_PACKET_WIDTH) + lane;
+            const uint32_t triangle = bvh.packets[p].index[lane];
+            if (triangle == MCRT_NO_HIT) continue;
+            lane_of_triangle[triangle] = uint32_t(p * MCRT_PACKET_WIDTH) + lane;
         }
     }
     std::vector<EmissiveTriangle> emitters = collect_emitters(scene);
@@ -252,9 +252,8 @@ GpuSceneData make_gpu_scene(const Scene& scene, const Bvh& bvh, const Camera& ca
     data.triangle_info.assign(bvh.packets.size() * MCRT_PACKET_WIDTH, gpu::TriangleInfo{});
     for (size_t p = 0; p < bvh.packets.size(); ++p) {
         for (int lane = 0; lane < MCRT_PACKET_WIDTH; ++lane) {
-            const uint32_t leaf = bvh.packets[p].index[lane];
-            if (leaf == MCRT_NO_HIT) continue;
-            const uint32_t scene_triangle = bvh.triangles[leaf].index;
+            const uint32_t scene_triangle = bvh.packets[p].index[lane];
+            if (scene_triangle == MCRT_NO_HIT) continue;
             gpu::TriangleInfo& info = data.triangle_info[p * MCRT_PACKET_WIDTH + size_t(lane)];
             info.material = scene.triangle_material[scene_triangle];
             info.light = light_of_triangle[scene_triangle];

@@ -143,6 +143,13 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
     hit.b1 = hit.b2 = 0.0f;
     hit.lane = MCRT_NO_HIT;
     uint hit_index = UINT_MAX; /* the winner's triangle index */
+    /* How far a box may begin and still hold a triangle at the held hit's t: t_max until a hit
+     * is held, then beyond the hit's t by the hit's rounding bound δt (intersect.cl) and the box
+     * test's (1 + 2γ3). A hit on a shared vertex or edge lies on its leaf boxes' faces, whose
+     * entry may round past the hit's t: without the margin, which of the tied triangles wins
+     * would depend on which box the tree culls. A tie with a triangle whose own δt is far larger
+     * than the winner's could still be culled. */
+    float reach = t_max;
 
     BoxRay b = make_box_ray(r);
     PacketRay q = make_packet_ray(r);
@@ -156,7 +163,7 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
     for (;;) {
         if (count == 0u) {
             global const Bvh4Node* node = nodes + ref;
-            float4 t4 = bvh4_entry(node, &b, hit.t);
+            float4 t4 = bvh4_entry(node, &b, reach);
             int4 entered = t4 != (float4)(MAXFLOAT);
             if (any(entered)) {
                 /* Children are visited nearest first, a later slot first among equals. A child's
@@ -197,9 +204,10 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
             float t_bound = hit.lane == MCRT_NO_HIT ? hit.t : nextafter(hit.t, MAXFLOAT);
             for (uint k = 0; k < count; k += MCRT_PACKET_WIDTH, ++pk) {
                 float4 t4 = (float4)(0.0f), b1 = (float4)(0.0f), b2 = (float4)(0.0f);
+                float4 dt4 = (float4)(0.0f);
                 uint packet = ref + k / MCRT_PACKET_WIDTH;
                 int4 lanes = intersect_packet(&q, pk, t_min, t_bound, skipped_lanes(&s, packet),
-                                              false, &t4, &b1, &b2);
+                                              false, &t4, &b1, &b2, &dt4);
 #if defined(MCRT_TEXTURES)
                 lanes = alpha_kept_lanes(alpha, packet, lanes, b1, b2);
 #endif
@@ -232,14 +240,17 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
                 hit.lane = nearer ? lane : hit.lane;
                 hit_index = nearer ? mi : hit_index;
                 t_bound = nextafter(hit.t, MAXFLOAT);
+                float hdt = i == 0 ? dt4.x : i == 1 ? dt4.y : i == 2 ? dt4.z : dt4.w;
+                reach = nearer ? min(t_max, (m + hdt) * (1.0f + 2.0f * MCRT_GAMMA3)) : reach;
             }
         }
-        /* Pop, skipping children entered beyond the closest hit found since they were pushed; a
-         * child entered exactly at the hit's t is visited, as it may hold a smaller index there. */
+        /* Pop, skipping children entered beyond the reach of the closest hit found since they
+         * were pushed; a child entered at the hit's t, or within rounding of it, is visited, as
+         * it may hold a smaller index there. */
         for (;;) {
             if (sp == 0) return hit;
             --sp;
-            if (stack_t[sp] <= hit.t) break;
+            if (stack_t[sp] <= reach) break;
         }
         ref = stack_ref[sp];
         count = stack_count[sp];
@@ -295,9 +306,10 @@ inline bool bvh_any_hit(global const Bvh4Node* nodes, global const TrianglePacke
             }
             global const TrianglePacket* pk = packets + child;
             for (uint k = 0; k < count; k += MCRT_PACKET_WIDTH, ++pk) {
-                float4 t4, b1, b2;
+                float4 t4, b1, b2, dt4;
                 int4 skipped = skipped_lanes(&sk, child + k / MCRT_PACKET_WIDTH);
-                int4 lanes = intersect_packet(&q, pk, 0.0f, t_max, skipped, true, &t4, &b1, &b2);
+                int4 lanes =
+                    intersect_packet(&q, pk, 0.0f, t_max, skipped, true, &t4, &b1, &b2, &dt4);
 #if defined(MCRT_TEXTURES)
                 lanes = alpha_kept_lanes(alpha, child + k / MCRT_PACKET_WIDTH, lanes, b1, b2);
 #endif

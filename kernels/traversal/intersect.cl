@@ -94,16 +94,18 @@ inline float4 packet_t_rounding_bound(const ShearedPacket* s, float4 az, float4 
  * (occlusion queries) a hit must also lie beyond its own rounding bound δt at both ends,
  * t in (δt, t_max − δt): a ray leaving a surface cannot then hit that surface's plane again
  * however large its triangles, nor a shadow ray the light's plane it ends at. The closest hit
- * checks its one winner instead (bvh_closest_hit). Lanes in `skip` are the triangle a ray
- * leaves: a flat triangle cannot be hit again by a ray leaving it. With -D MCRT_SINGLE_SIDED a
- * lane marked MCRT_TRIANGLE_CULLED is not hit from behind, in every query alike. Forced inline: PoCL's inliner
- * prices it just over its threshold (565 against 562) and called it, which cost the closest hit
- * about 10% (docs/BENCHMARKS.md). */
+ * checks its one winner instead (bvh_closest_hit). Where a lane is hit, `delta` receives every
+ * lane's δt, from which the closest hit bounds how far a box holding a tie may begin. Lanes in
+ * `skip` are the triangle a ray leaves: a flat triangle cannot be hit again by a ray leaving it.
+ * With -D MCRT_SINGLE_SIDED a lane marked MCRT_TRIANGLE_CULLED is not hit from behind, in every
+ * query alike. Forced inline: PoCL's inliner prices it just over its threshold (565 against 562)
+ * and called it, which cost the closest hit about 10% (docs/BENCHMARKS.md). */
 inline __attribute__((always_inline)) int4 intersect_packet(const PacketRay* q,
                                                             global const TrianglePacket* pk,
                                                             float t_min, float t_max, int4 skip,
                                                             bool bounded, float4* t_hit,
-                                                            float4* b1, float4* b2) {
+                                                            float4* b1, float4* b2,
+                                                            float4* delta) {
     ShearedPacket s = shear_packet(q, pk);
     float4 ax = s.ax, ay = s.ay, bx = s.bx, by = s.by, cx = s.cx, cy = s.cy;
 
@@ -142,9 +144,11 @@ inline __attribute__((always_inline)) int4 intersect_packet(const PacketRay* q,
     *b1 = v_ * inv_det;
     *b2 = w_ * inv_det;
     hit &= (t > (float4)(t_min)) & (t < (float4)(t_max));
-    if (!bounded || !any(hit)) return hit;
+    if (!any(hit)) return hit;
 
     float4 delta_t = packet_t_rounding_bound(&s, az, bz, cz, inv_det);
+    *delta = delta_t;
+    if (!bounded) return hit;
     return hit & (t > delta_t) & (t < (float4)(t_max) - delta_t);
 }
 

@@ -4,7 +4,7 @@
 #include "bvh_traverse.cl"
 
 /* Closest hit of ray g: origins[g].xyz, directions[g].xyz, t_max in origins[g].w. Writes
- * hits[g] = (t, b1, b2, leaf-order triangle index as uint bits; MCRT_NO_HIT on a miss). */
+ * hits[g] = (t, b1, b2, the scene's triangle index as uint bits; MCRT_NO_HIT on a miss). */
 kernel void trace_closest(global const Bvh4Node* nodes, global const TrianglePacket* packets,
                           global const float4* origins, global const float4* directions,
                           uint ray_count, global float4* hits) {

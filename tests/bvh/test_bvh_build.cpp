@@ -192,6 +192,9 @@ void validate4(const Bvh& bvh, const BvhBuildOptions& options) {
     std::vector<int> reached(bvh.nodes4.size(), 0), covered(n, 0),
         packet_uses(bvh.packets.size(), 0);
     std::vector<std::pair<uint32_t, uint32_t>> leaves4, leaves2;
+    std::vector<uint32_t> leaf_position(n, UINT32_MAX);  // of each scene triangle
+    for (uint32_t i = 0; i < n; ++i)
+        if (bvh.triangles[i].index < n) leaf_position[bvh.triangles[i].index] = i;
     size_t problems = 0, infinite = 0, lonely = 0;
     int depth = 0;
     double cost = 0.0, root_area = 0.0;
@@ -227,14 +230,17 @@ void validate4(const Bvh& bvh, const BvhBuildOptions& options) {
                 stack.push_back({node.child[s], item.level + 1, b, true});
                 continue;
             }
-            // The slot names the leaf's first packet; its lanes name the triangles in leaf order.
+            // The slot names the leaf's first packet; its lanes hold the leaf's triangles in leaf
+            // order, each named by its scene index (the closest hit's tie-break).
             const uint32_t packet = node.child[s], count = node.count[s];
             if (count > uint32_t(options.max_leaf_size) ||
                 size_t(packet) + packets_for(count) > bvh.packets.size()) {
                 ++problems;
                 continue;
             }
-            const uint32_t first = bvh.packets[packet].index[0];
+            // The leaf's triangles are a run of the leaf-ordered array.
+            const uint32_t named = bvh.packets[packet].index[0];
+            const uint32_t first = named < n ? leaf_position[named] : UINT32_MAX;
             if (size_t(first) + count > n) {
                 ++problems;
                 continue;
@@ -249,7 +255,7 @@ void validate4(const Bvh& bvh, const BvhBuildOptions& options) {
                         for (int v = 0; v < 9; ++v) problems += lane(p.v[v], int(i)) != 0.0f;
                         continue;
                     }
-                    if (p.index[i] != first + j) ++problems;
+                    if (p.index[i] != bvh.triangles[first + j].index) ++problems;
                     const gpu::Triangle& t = bvh.triangles[first + j];
                     const gpu::float4* q[3] = {&t.p0, &t.p1, &t.p2};
                     for (int v = 0; v < 3; ++v)
@@ -486,13 +492,14 @@ Hit traverse4(const Bvh& bvh, const Ray& ray, bool& overflow) {
                 stack.push_back(node.child[s]);
                 continue;
             }
-            const uint32_t first = bvh.packets[node.child[s]].index[0];
-            for (uint32_t i = first; i < first + node.count[s]; ++i) {
-                const gpu::Triangle& tri = bvh.triangles[i];
-                float t =
-                    intersect(ray, {tri.p0.x, tri.p0.y, tri.p0.z}, {tri.p1.x, tri.p1.y, tri.p1.z},
-                              {tri.p2.x, tri.p2.y, tri.p2.z}, h.t);
-                if (t > 0.0f) h = {t, int64_t(tri.index)};
+            for (uint32_t j = 0; j < node.count[s]; ++j) {
+                const gpu::TrianglePacket& p = bvh.packets[node.child[s] + j / MCRT_PACKET_WIDTH];
+                const int i = int(j % MCRT_PACKET_WIDTH);
+                glm::vec3 v[3];
+                for (int k = 0; k < 3; ++k)
+                    v[k] = {lane(p.v[3 * k], i), lane(p.v[3 * k + 1], i), lane(p.v[3 * k + 2], i)};
+                float t = intersect(ray, v[0], v[1], v[2], h.t);
+                if (t > 0.0f) h = {t, int64_t(p.index[i])};
             }
         }
         // Unordered, so bounded by 4 per level rather than the kernels' 3.

@@ -89,10 +89,10 @@ void check_host_structures(const mcrt::Scene& scene) {
     const mcrt::Bvh bvh = mcrt::build_bvh(scene);
     std::vector<int> seen(scene.triangle_count(), 0);
     for (const mcrt::gpu::TrianglePacket& p : bvh.packets)
-        for (uint32_t leaf : p.index) {
-            if (leaf == 0xffffffffu) continue;
-            require(leaf < bvh.triangles.size(), "packet lane in range");
-            if (leaf < seen.size()) ++seen[leaf];
+        for (uint32_t triangle : p.index) {
+            if (triangle == 0xffffffffu) continue;
+            require(triangle < seen.size(), "packet lane in range");
+            if (triangle < seen.size()) ++seen[triangle];
         }
     for (int n : seen) require(n == 1, "every triangle in one packet lane");
     require(bvh.stats.depth4 <= mcrt::kMaxBvh4Depth, "BVH4 depth within the stack bound");
