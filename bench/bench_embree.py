@@ -3,11 +3,19 @@
 
 Usage: bench/bench_embree.py [--rounds R] [--size WxH] [--repeats K] [--scenes S ...]
                                [--mcrt BINARY] [-- EXTRA BENCH OPTIONS]
+       bench/bench_embree.py --variant LABEL=BINARY[@KERNEL_DIR] --variant ... \
+                               [--variant-options LABEL="OPTIONS"] [the options above]
 Runs build/mcrt bench on each scene R times (scenes taken in turn, round by round, so that a
 change in the machine's load spreads over all of them) and prints one Markdown row per scene
 and ray kind: medians over the rounds of mcrt's and Embree's Mrays/s and of the ratio measured
 within each run (both tracers alternate launch by launch inside a run). Needs an mcrt built with
 Embree (scripts/setup installs libembree-dev). Only the standard library.
+
+With --variant (as bench/bench_ab.py: a binary, its kernels from KERNEL_DIR through
+MCRT_KERNEL_DIR if given, and options of its own), every variant runs each scene in turn within
+each round, the table above is the first variant's, and a second table compares the variants'
+own rates: a tree or kernel change against another in one run, where Embree's rate, which
+moves between modes minutes apart, does not enter.
 """
 import argparse
 import json
@@ -18,6 +26,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts/tools"))  # mcrt_run, mcrt_exr
 import mcrt_run  # noqa: E402
+from bench_ab import parse_variant, parse_variant_options  # noqa: E402
 
 SHARED = os.path.join(os.path.dirname(mcrt_run.ROOT), "shared", "scenes")
 SCENES = ["sponza/crytek-sponza.gltf", "stanford/dragon_vrip_res2.glb",
@@ -30,11 +39,13 @@ def load_average():
         return float(f.read().split()[0])
 
 
-def bench(scene, args, extra):
+def bench(scene, args, extra, binary=None, kernels=None):
     """`mcrt bench SCENE --json`: ray kind → its JSON line."""
-    cmd = [mcrt_run.mcrt_binary(args.mcrt), "bench", scene, "--json", "--width", args.width,
-           "--height", args.height, "--repeats", args.repeats] + extra
-    out = mcrt_run.run(cmd).stdout
+    cmd = [mcrt_run.mcrt_binary(binary or args.mcrt), "bench", scene, "--json", "--width",
+           args.width, "--height", args.height, "--repeats", args.repeats] + extra
+    # kernels None: the environment's MCRT_KERNEL_DIR, if any; "": the binary's own kernels.
+    env = None if kernels is None else {"MCRT_KERNEL_DIR": kernels}
+    out = mcrt_run.run(cmd, env=env).stdout
     try:
         lines = [json.loads(line) for line in out.splitlines() if line.strip()]
     except ValueError as e:
@@ -51,19 +62,61 @@ def main():
     p.add_argument("--repeats", type=int, default=5)
     p.add_argument("--scenes", nargs="+", default=[os.path.join(SHARED, s) for s in SCENES])
     mcrt_run.add_mcrt_option(p)
+    p.add_argument("--variant", action="append", type=parse_variant, default=[],
+                   help="LABEL=BINARY[@KERNEL_DIR]; the first is the baseline")
+    p.add_argument("--variant-options", action="append", type=parse_variant_options, default=[],
+                   help='LABEL="OPTIONS": `mcrt bench` options of that variant alone')
     p.add_argument("extra", nargs="*", help="further `mcrt bench` options, after --")
     args = p.parse_args()
     args.width, args.height = args.size
+    # A variant without KERNEL_DIR runs its binary's own kernels, whatever the environment says.
+    variants = [(label, binary, kernels or "") for label, binary, kernels in args.variant] or \
+        [("mcrt", args.mcrt, None)]
+    labels = [v[0] for v in variants]
+    own = dict(args.variant_options)
+    unknown = sorted(set(own) - set(labels))
+    if unknown or len(set(labels)) != len(labels):
+        raise mcrt_run.ScriptError("--variant labels must differ, and --variant-options name "
+                                   "one of them: %s" % ", ".join(unknown or labels))
 
-    runs = {s: [] for s in args.scenes}
+    # runs[label][scene]: that variant's JSON lines, one per round.
+    runs = {label: {s: [] for s in args.scenes} for label in labels}
     loads = [load_average()]
     for _ in range(args.rounds):
         for s in args.scenes:
-            runs[s].append(bench(s, args, args.extra))
+            for label, binary, kernels in variants:
+                runs[label][s].append(
+                    bench(s, args, args.extra + own.get(label, []), binary, kernels))
             loads.append(load_average())
+    print_embree_table(args, runs[labels[0]], loads, labels[0] if args.variant else "mcrt")
+    if len(variants) > 1:
+        print()
+        print_variant_table(args, runs, labels)
 
+
+def print_variant_table(args, runs, labels):
+    """Each variant's own Mrays/s (median and range over the rounds) and the median of its
+    per-round ratios to the first variant's: a round's runs are a few seconds apart."""
     med = statistics.median
-    print(f"{args.rounds} rounds, {args.width}x{args.height}, median of {args.repeats} per run; "
+    base = labels[0]
+    print("| scene | rays | " + " | ".join(f"{label} Mrays/s" for label in labels) + " | " +
+          " | ".join(f"{label}/{base} (min-max)" for label in labels[1:]) + " |")
+    print("|---|---|" + "---:|" * (2 * len(labels) - 1))
+    for s in args.scenes:
+        for kind in KINDS:
+            rates = {label: [r[kind]["mrays_per_s"] for r in runs[label][s]] for label in labels}
+            cells = [f"{med(rates[label]):.2f} ({min(rates[label]):.2f}-{max(rates[label]):.2f})"
+                     for label in labels]
+            for label in labels[1:]:
+                ratios = [a / b for a, b in zip(rates[label], rates[base])]
+                cells.append(f"{med(ratios):.3f} ({min(ratios):.3f}-{max(ratios):.3f})")
+            print(f"| {os.path.basename(s)} | {kind} | " + " | ".join(cells) + " |")
+
+
+def print_embree_table(args, runs, loads, label):
+    """mcrt against Embree, one variant's runs: runs[scene] holds its JSON lines."""
+    med = statistics.median
+    print(f"{label} against Embree: {args.rounds} rounds, {args.width}x{args.height}, median of {args.repeats} per run; "
           f"1-minute load average {min(loads):.1f}-{max(loads):.1f}")
     print()
     print("| scene (triangles) | rays | count | mcrt Mrays/s | Embree Mrays/s | ratio (min-max) "
