@@ -74,10 +74,11 @@ def main():
         [("mcrt", args.mcrt, None)]
     labels = [v[0] for v in variants]
     own = dict(args.variant_options)
+    if len(set(labels)) != len(labels):
+        raise mcrt_run.ScriptError("two --variant share a label: %s" % ", ".join(labels))
     unknown = sorted(set(own) - set(labels))
-    if unknown or len(set(labels)) != len(labels):
-        raise mcrt_run.ScriptError("--variant labels must differ, and --variant-options name "
-                                   "one of them: %s" % ", ".join(unknown or labels))
+    if unknown:
+        raise mcrt_run.ScriptError("--variant-options names no --variant: %s" % ", ".join(unknown))
 
     # runs[label][scene]: that variant's JSON lines, one per round.
     runs = {label: {s: [] for s in args.scenes} for label in labels}
