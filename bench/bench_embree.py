@@ -89,7 +89,7 @@ def main():
                 runs[label][s].append(
                     bench(s, args, args.extra + own.get(label, []), binary, kernels))
             loads.append(load_average())
-    print_embree_table(args, runs[labels[0]], loads, labels[0] if args.variant else "mcrt")
+    print_embree_table(args, runs[labels[0]], loads, labels[0])
     if len(variants) > 1:
         print()
         print_variant_table(args, runs, labels)
@@ -117,7 +117,8 @@ def print_variant_table(args, runs, labels):
 def print_embree_table(args, runs, loads, label):
     """mcrt against Embree, one variant's runs: runs[scene] holds its JSON lines."""
     med = statistics.median
-    print(f"{label} against Embree: {args.rounds} rounds, {args.width}x{args.height}, median of {args.repeats} per run; "
+    print(f"{label} against Embree: {args.rounds} rounds, {args.width}x{args.height}, "
+          f"median of {args.repeats} per run; "
           f"1-minute load average {min(loads):.1f}-{max(loads):.1f}")
     print()
     print("| scene (triangles) | rays | count | mcrt Mrays/s | Embree Mrays/s | ratio (min-max) "

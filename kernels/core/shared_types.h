@@ -99,9 +99,9 @@ typedef struct {
 /* Up to four triangles of one leaf in SoA form, 160 bytes, so that one watertight test in float4
  * arithmetic covers all four (Wald, Benthin, Boulos 2008; Embree's triangle4). v[3k + a] holds
  * coordinate a (x, y, z) of vertex k of the four lanes; index[i] is lane i's triangle in the
- * scene's order (the glTF order, which the closest hit's ties follow whatever the tree), MCRT_NO_HIT
- * for an unused lane, whose vertices are 0. In the
- * device scene (host/render/gpu_scene.cpp) a lane's index also carries MCRT_TRIANGLE_CULLED. */
+ * scene's (glTF) order, which the closest hit's ties follow whatever the tree, MCRT_NO_HIT for an
+ * unused lane, whose vertices are 0. In the device scene (host/render/gpu_scene.cpp) a lane's
+ * index also carries MCRT_TRIANGLE_CULLED. */
 typedef struct {
     float4 v[9];    /* 0: x0, y0, z0, x1, y1, z1, x2, y2, z2 */
     uint index[4];  /* 144 */
