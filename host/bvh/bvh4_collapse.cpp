@@ -178,9 +178,9 @@ std::vector<gpu::TrianglePacket> pack_leaves(std::vector<gpu::Bvh4Node>& nodes,
                     const gpu::Triangle& t = triangles[first + k + i];
                     const gpu::float4* v[3] = {&t.p0, &t.p1, &t.p2};
                     for (int j = 0; j < 3; ++j) {
-                        set_lane(p.v[2 * (3 * j + 0) + i / 4], int(i % 4), v[j]->x);
-                        set_lane(p.v[2 * (3 * j + 1) + i / 4], int(i % 4), v[j]->y);
-                        set_lane(p.v[2 * (3 * j + 2) + i / 4], int(i % 4), v[j]->z);
+                        set_lane(p.v[3 * j + 0], int(i), v[j]->x);
+                        set_lane(p.v[3 * j + 1], int(i), v[j]->y);
+                        set_lane(p.v[3 * j + 2], int(i), v[j]->z);
                     }
                     p.index[i] = t.index;
                 }

@@ -103,8 +103,8 @@ typedef struct {
  * unused lane, whose vertices are 0. In the device scene (host/render/gpu_scene.cpp) a lane's
  * index also carries MCRT_TRIANGLE_CULLED. */
 typedef struct {
-    float4 v[18];   /* 0: x0, y0, z0, x1, y1, z1, x2, y2, z2, eight lanes each */
-    uint index[8];  /* 288 */
+    float4 v[9];    /* 0: x0, y0, z0, x1, y1, z1, x2, y2, z2 */
+    uint index[4];  /* 144 */
 } TrianglePacket;
 
 /* Set in a used lane's TrianglePacket.index: the triangle is single-sided (glTF `doubleSided`
@@ -115,7 +115,7 @@ typedef struct {
 #define MCRT_TRIANGLE_INDEX_MASK 0x7fffffffu
 
 /* Triangles per TrianglePacket: the SAH counts a leaf of N triangles as ceil(N / 4) tests. */
-#define MCRT_PACKET_WIDTH 8
+#define MCRT_PACKET_WIDTH 4
 
 /* What shading needs of a hit triangle besides its vertices (which it reads from the packet),
  * 8 bytes, one per packet lane: info[4 · packet + lane]; unused lanes hold zeros. */
@@ -432,7 +432,7 @@ enum RenderArgument {
     TYPE(Bvh4Node, 128, 16) FIELD(Bvh4Node, lo_x, 0) FIELD(Bvh4Node, hi_x, 16)                  \
     FIELD(Bvh4Node, lo_y, 32) FIELD(Bvh4Node, hi_y, 48) FIELD(Bvh4Node, lo_z, 64)               \
     FIELD(Bvh4Node, hi_z, 80) FIELD(Bvh4Node, child, 96) FIELD(Bvh4Node, count, 112)            \
-    TYPE(TrianglePacket, 320, 16) FIELD(TrianglePacket, v, 0) FIELD(TrianglePacket, index, 288) \
+    TYPE(TrianglePacket, 160, 16) FIELD(TrianglePacket, v, 0) FIELD(TrianglePacket, index, 144) \
     TYPE(TriangleInfo, 8, 4) FIELD(TriangleInfo, material, 0) FIELD(TriangleInfo, light, 4)     \
     TYPE(Triangle, 64, 16) FIELD(Triangle, p0, 0) FIELD(Triangle, p1, 16)                       \
     FIELD(Triangle, p2, 32) FIELD(Triangle, material, 48) FIELD(Triangle, index, 52)            \

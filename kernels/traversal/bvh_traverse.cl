@@ -29,17 +29,14 @@ inline bool alpha_keeps_lane(const AlphaTest* at, uint lane, float b1, float b2)
 }
 
 /* The lanes of a packet's hits that alpha keeps; all of them for a query without a test. */
-inline int8 alpha_kept_lanes(const AlphaTest* at, uint packet, int8 lanes, float8 b1, float8 b2) {
+inline int4 alpha_kept_lanes(const AlphaTest* at, uint packet, int4 lanes, float4 b1, float4 b2) {
     if (!at || !any(lanes)) return lanes;
     uint base = MCRT_PACKET_WIDTH * packet;
-    int l[8];
-    float u[8], v[8];
-    vstore8(lanes, 0, l);
-    vstore8(b1, 0, u);
-    vstore8(b2, 0, v);
-    for (uint i = 0u; i < 8u; ++i)
-        if (l[i] && !alpha_keeps_lane(at, base + i, u[i], v[i])) l[i] = 0;
-    return vload8(0, l);
+    if (lanes.x && !alpha_keeps_lane(at, base, b1.x, b2.x)) lanes.x = 0;
+    if (lanes.y && !alpha_keeps_lane(at, base + 1u, b1.y, b2.y)) lanes.y = 0;
+    if (lanes.z && !alpha_keeps_lane(at, base + 2u, b1.z, b2.z)) lanes.z = 0;
+    if (lanes.w && !alpha_keeps_lane(at, base + 3u, b1.w, b2.w)) lanes.w = 0;
+    return lanes;
 }
 #else
 /* Untextured builds test no alpha: every query passes a null AlphaTest. */
@@ -120,26 +117,18 @@ inline float4 bvh4_entry(global const Bvh4Node* node, const BoxRay* b, float t_m
  * again by a ray leaving it, so skipping it is exact. */
 typedef struct {
     uint packet;
-    int8 lanes;
+    int4 lanes;
 } SkipLane;
 
 inline SkipLane make_skip_lane(uint lane) {
     SkipLane s;
     s.packet = lane == MCRT_NO_HIT ? MCRT_NO_HIT : lane / MCRT_PACKET_WIDTH;
-    s.lanes = (int8)(0, 1, 2, 3, 4, 5, 6, 7) == (int8)((int)(lane % MCRT_PACKET_WIDTH));
+    s.lanes = (int4)(0, 1, 2, 3) == (int4)((int)(lane % MCRT_PACKET_WIDTH));
     return s;
 }
 
-inline int8 skipped_lanes(const SkipLane* s, uint packet) {
-    return packet == s->packet ? s->lanes : (int8)(0);
-}
-
-/* The bits of the one lane set in `one` (the others read 0). */
-inline uint lane_bits(uint8 v, int8 one) {
-    uint8 x = v & as_uint8(one);
-    uint4 a = x.lo | x.hi;
-    uint2 b = a.xy | a.zw;
-    return b.x | b.y;
+inline int4 skipped_lanes(const SkipLane* s, uint packet) {
+    return packet == s->packet ? s->lanes : (int4)(0);
 }
 
 /* Closest hit with t in (t_min, t_max), never on the triangle at packet lane `skip`
@@ -214,45 +203,36 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
             global const TrianglePacket* pk = packets + ref;
             float t_bound = hit.lane == MCRT_NO_HIT ? hit.t : nextafter(hit.t, MAXFLOAT);
             for (uint k = 0; k < count; k += MCRT_PACKET_WIDTH, ++pk) {
-                float8 t8 = (float8)(0.0f), b1 = (float8)(0.0f), b2 = (float8)(0.0f);
-                float8 dt8 = (float8)(0.0f);
+                float4 t4 = (float4)(0.0f), b1 = (float4)(0.0f), b2 = (float4)(0.0f);
+                float4 dt4 = (float4)(0.0f);
                 uint packet = ref + k / MCRT_PACKET_WIDTH;
-                int8 lanes = intersect_packet(&q, pk, t_min, t_bound, skipped_lanes(&s, packet),
-                                              false, &t8, &b1, &b2, &dt8);
+                int4 lanes = intersect_packet(&q, pk, t_min, t_bound, skipped_lanes(&s, packet),
+                                              false, &t4, &b1, &b2, &dt4);
 #if defined(MCRT_TEXTURES)
                 lanes = alpha_kept_lanes(alpha, packet, lanes, b1, b2);
 #endif
                 /* The nearest hit lane, the smallest triangle index among equals, by compares
                  * instead of a loop over private arrays; taken by selects, not a branch on
                  * whether any lane hit (which mispredicted). */
-                float8 tm = select((float8)(MAXFLOAT), t8, lanes);
-                float4 m4 = min(tm.lo, tm.hi);
-                float2 m2 = min(m4.xy, m4.zw);
+                float4 tm = select((float4)(MAXFLOAT), t4, lanes);
+                float2 m2 = min(tm.xy, tm.zw);
                 float m = min(m2.x, m2.y);
-                int8 at_m = lanes & (tm == (float8)(m));
-                const int8 lane_no = (int8)(0, 1, 2, 3, 4, 5, 6, 7);
-                /* The first lane at m; among ties, the smallest triangle index. */
-                int8 cand = select((int8)(8), lane_no, at_m);
-                uint8 idx8 = vload8(0, pk->index) & (uint8)(PACKET_INDEX_MASK);
+                int i = tm.x == m ? 0 : tm.y == m ? 1 : tm.z == m ? 2 : 3;
+                int4 at_m = lanes & (tm == (float4)(m));
+                uint mi = pk->index[i] & PACKET_INDEX_MASK;
                 /* Ties (two lanes at m, or m at the held t) are rare: a branch that is almost
                  * never taken, rather than the index compares on every packet. */
-                int at_count = -((at_m.s0 + at_m.s1 + at_m.s2 + at_m.s3) +
-                                 (at_m.s4 + at_m.s5 + at_m.s6 + at_m.s7));
-                if (at_count > 1) {
-                    uint8 idx = select((uint8)(UINT_MAX), idx8, as_uint8(at_m));
-                    uint4 i4 = min(idx.lo, idx.hi);
-                    uint2 i2 = min(i4.xy, i4.zw);
-                    uint least = min(i2.x, i2.y);
-                    cand = select((int8)(8), lane_no, at_m & (idx == (uint8)(least)));
+                if (-(at_m.x + at_m.y + at_m.z + at_m.w) > 1) {
+                    uint4 idx = select((uint4)(UINT_MAX),
+                                       vload4(0, pk->index) & (uint4)(PACKET_INDEX_MASK),
+                                       as_uint4(at_m));
+                    uint2 i2 = min(idx.xy, idx.zw);
+                    mi = min(i2.x, i2.y);
+                    i = idx.x == mi ? 0 : idx.y == mi ? 1 : idx.z == mi ? 2 : 3;
                 }
-                int4 c4 = min(cand.lo, cand.hi);
-                int2 c2 = min(c4.xy, c4.zw);
-                int i = min(c2.x, c2.y) & 7;
-                int8 one = lane_no == (int8)(i);
-                uint mi = lane_bits(idx8, one);
                 bool nearer = m < hit.t || (m == hit.t && any(lanes) && mi < hit_index);
-                float hb1 = as_float(lane_bits(as_uint8(b1), one));
-                float hb2 = as_float(lane_bits(as_uint8(b2), one));
+                float hb1 = i == 0 ? b1.x : i == 1 ? b1.y : i == 2 ? b1.z : b1.w;
+                float hb2 = i == 0 ? b2.x : i == 1 ? b2.y : i == 2 ? b2.z : b2.w;
                 uint lane = MCRT_PACKET_WIDTH * packet + (uint)i;
                 hit.t = nearer ? m : hit.t;
                 hit.b1 = nearer ? hb1 : hit.b1;
@@ -260,7 +240,7 @@ inline __attribute__((always_inline)) Hit bvh_closest_hit_beyond(
                 hit.lane = nearer ? lane : hit.lane;
                 hit_index = nearer ? mi : hit_index;
                 t_bound = nextafter(hit.t, MAXFLOAT);
-                float hdt = as_float(lane_bits(as_uint8(dt8), one));
+                float hdt = i == 0 ? dt4.x : i == 1 ? dt4.y : i == 2 ? dt4.z : dt4.w;
                 reach = nearer ? min(t_max, (m + hdt) * (1.0f + 2.0f * MCRT_GAMMA3)) : reach;
             }
         }
@@ -326,10 +306,10 @@ inline bool bvh_any_hit(global const Bvh4Node* nodes, global const TrianglePacke
             }
             global const TrianglePacket* pk = packets + child;
             for (uint k = 0; k < count; k += MCRT_PACKET_WIDTH, ++pk) {
-                float8 t8, b1, b2, dt8;
-                int8 skipped = skipped_lanes(&sk, child + k / MCRT_PACKET_WIDTH);
-                int8 lanes =
-                    intersect_packet(&q, pk, 0.0f, t_max, skipped, true, &t8, &b1, &b2, &dt8);
+                float4 t4, b1, b2, dt4;
+                int4 skipped = skipped_lanes(&sk, child + k / MCRT_PACKET_WIDTH);
+                int4 lanes =
+                    intersect_packet(&q, pk, 0.0f, t_max, skipped, true, &t4, &b1, &b2, &dt4);
 #if defined(MCRT_TEXTURES)
                 lanes = alpha_kept_lanes(alpha, child + k / MCRT_PACKET_WIDTH, lanes, b1, b2);
 #endif

@@ -14,20 +14,20 @@
 /* The ray as the four-lane test reads it: its origin on the permuted axes kx, ky, kz and its
  * shear, splatted, and the permutation as indices into TrianglePacket.v. */
 typedef struct {
-    float8 org_x, org_y, org_z;
-    float8 shear_x, shear_y, shear_z;
+    float4 org_x, org_y, org_z;
+    float4 shear_x, shear_y, shear_z;
     uint kx, ky, kz;
 } PacketRay;
 
 inline PacketRay make_packet_ray(const Ray* r) {
     PacketRay q;
     float4 o = shuffle((float4)(r->org, 0.0f), r->shear_axes);
-    q.org_x = (float8)(o.x);
-    q.org_y = (float8)(o.y);
-    q.org_z = (float8)(o.z);
-    q.shear_x = (float8)(r->shear.x);
-    q.shear_y = (float8)(r->shear.y);
-    q.shear_z = (float8)(r->shear.z);
+    q.org_x = (float4)(o.x);
+    q.org_y = (float4)(o.y);
+    q.org_z = (float4)(o.z);
+    q.shear_x = (float4)(r->shear.x);
+    q.shear_y = (float4)(r->shear.y);
+    q.shear_z = (float4)(r->shear.z);
     q.kx = r->shear_axes.x;
     q.ky = r->shear_axes.y;
     q.kz = r->shear_axes.z;
@@ -45,9 +45,9 @@ inline PacketRay make_packet_ray(const Ray* r) {
  * (|S_x|, |S_y| ≤ 1), and the scaled one is 1/|d| times too large for a ray whose direction is
  * not unit (a shadow ray's spans its segment): every hit of a short segment would fall within
  * its own "error". */
-inline float8 t_rounding_bound(float8 max_zt, float8 max_z, float8 max_xt, float8 max_yt,
-                               float8 inv_det) {
-    float8 half_delta_e = (MCRT_GAMMA(2) + 2.0f * MCRT_GAMMA(5)) * max_xt * max_yt +
+inline float4 t_rounding_bound(float4 max_zt, float4 max_z, float4 max_xt, float4 max_yt,
+                               float4 inv_det) {
+    float4 half_delta_e = (MCRT_GAMMA(2) + 2.0f * MCRT_GAMMA(5)) * max_xt * max_yt +
                           MCRT_GAMMA(5) * max_z * (max_xt + max_yt);
     return max_zt * (6.0f * MCRT_GAMMA(3) + 6.0f * half_delta_e * fabs(inv_det));
 }
@@ -55,29 +55,29 @@ inline float8 t_rounding_bound(float8 max_zt, float8 max_z, float8 max_xt, float
 /* A packet's vertices translated to the ray origin and permuted (z the dominant axis), with x
  * and y sheared (Woop et al. 2013, sec. 3); z is not yet scaled by 1/d_z. */
 typedef struct {
-    float8 ax, ay, bx, by, cx, cy;
-    float8 a_z, b_z, c_z;
+    float4 ax, ay, bx, by, cx, cy;
+    float4 a_z, b_z, c_z;
 } ShearedPacket;
 
 inline __attribute__((always_inline)) ShearedPacket shear_packet(const PacketRay* q,
                                                                  global const TrianglePacket* pk) {
-    global const float* v = (global const float*)pk->v;
+    global const float4* v = pk->v;
     ShearedPacket s;
-    s.a_z = vload8(q->kz, v) - q->org_z;
-    s.b_z = vload8(3u + q->kz, v) - q->org_z;
-    s.c_z = vload8(6u + q->kz, v) - q->org_z;
-    s.ax = (vload8(q->kx, v) - q->org_x) - q->shear_x * s.a_z;
-    s.ay = (vload8(q->ky, v) - q->org_y) - q->shear_y * s.a_z;
-    s.bx = (vload8(3u + q->kx, v) - q->org_x) - q->shear_x * s.b_z;
-    s.by = (vload8(3u + q->ky, v) - q->org_y) - q->shear_y * s.b_z;
-    s.cx = (vload8(6u + q->kx, v) - q->org_x) - q->shear_x * s.c_z;
-    s.cy = (vload8(6u + q->ky, v) - q->org_y) - q->shear_y * s.c_z;
+    s.a_z = v[q->kz] - q->org_z;
+    s.b_z = v[3u + q->kz] - q->org_z;
+    s.c_z = v[6u + q->kz] - q->org_z;
+    s.ax = (v[q->kx] - q->org_x) - q->shear_x * s.a_z;
+    s.ay = (v[q->ky] - q->org_y) - q->shear_y * s.a_z;
+    s.bx = (v[3u + q->kx] - q->org_x) - q->shear_x * s.b_z;
+    s.by = (v[3u + q->ky] - q->org_y) - q->shear_y * s.b_z;
+    s.cx = (v[6u + q->kx] - q->org_x) - q->shear_x * s.c_z;
+    s.cy = (v[6u + q->ky] - q->org_y) - q->shear_y * s.c_z;
     return s;
 }
 
 /* t_rounding_bound of the four lanes of a sheared packet, az..cz its z scaled by 1/d_z. */
-inline float8 packet_t_rounding_bound(const ShearedPacket* s, float8 az, float8 bz, float8 cz,
-                                      float8 inv_det) {
+inline float4 packet_t_rounding_bound(const ShearedPacket* s, float4 az, float4 bz, float4 cz,
+                                      float4 inv_det) {
     return t_rounding_bound(max(fabs(az), max(fabs(bz), fabs(cz))),
                             max(fabs(s->a_z), max(fabs(s->b_z), fabs(s->c_z))),
                             max(fabs(s->ax), max(fabs(s->bx), fabs(s->cx))),
@@ -100,69 +100,67 @@ inline float8 packet_t_rounding_bound(const ShearedPacket* s, float8 az, float8 
  * With -D MCRT_SINGLE_SIDED a lane marked MCRT_TRIANGLE_CULLED is not hit from behind, in every
  * query alike. Forced inline: PoCL's inliner prices it just over its threshold (565 against 562)
  * and called it, which cost the closest hit about 10% (docs/BENCHMARKS.md). */
-inline __attribute__((always_inline)) int8 intersect_packet(const PacketRay* q,
+inline __attribute__((always_inline)) int4 intersect_packet(const PacketRay* q,
                                                             global const TrianglePacket* pk,
-                                                            float t_min, float t_max, int8 skip,
-                                                            bool bounded, float8* t_hit,
-                                                            float8* b1, float8* b2,
-                                                            float8* delta) {
+                                                            float t_min, float t_max, int4 skip,
+                                                            bool bounded, float4* t_hit,
+                                                            float4* b1, float4* b2,
+                                                            float4* delta) {
     ShearedPacket s = shear_packet(q, pk);
-    float8 ax = s.ax, ay = s.ay, bx = s.bx, by = s.by, cx = s.cx, cy = s.cy;
+    float4 ax = s.ax, ay = s.ay, bx = s.bx, by = s.by, cx = s.cx, cy = s.cy;
 
-    float8 u = cx * by - cy * bx;
-    float8 w_ = bx * ay - by * ax;
-    float8 v_ = ax * cy - ay * cx;
-    int8 used = (as_int8(vload8(0, pk->index)) != (int8)(-1)) & ~skip;
+    float4 u = cx * by - cy * bx;
+    float4 w_ = bx * ay - by * ax;
+    float4 v_ = ax * cy - ay * cx;
+    int4 used = (as_int4(vload4(0, pk->index)) != (int4)(-1)) & ~skip;
 #ifdef MCRT_HAVE_FP64
-    int8 zero = used & ((u == 0.0f) | (v_ == 0.0f) | (w_ == 0.0f));
+    int4 zero = used & ((u == 0.0f) | (v_ == 0.0f) | (w_ == 0.0f));
     if (any(zero)) {
-        double8 dax = convert_double8(ax), day = convert_double8(ay);
-        double8 dbx = convert_double8(bx), dby = convert_double8(by);
-        double8 dcx = convert_double8(cx), dcy = convert_double8(cy);
-        u = select(u, convert_float8(dcx * dby - dcy * dbx), zero);
-        v_ = select(v_, convert_float8(dax * dcy - day * dcx), zero);
-        w_ = select(w_, convert_float8(dbx * day - dby * dax), zero);
+        double4 dax = convert_double4(ax), day = convert_double4(ay);
+        double4 dbx = convert_double4(bx), dby = convert_double4(by);
+        double4 dcx = convert_double4(cx), dcy = convert_double4(cy);
+        u = select(u, convert_float4(dcx * dby - dcy * dbx), zero);
+        v_ = select(v_, convert_float4(dax * dcy - day * dcx), zero);
+        w_ = select(w_, convert_float4(dbx * day - dby * dax), zero);
     }
 #endif
-    int8 negative = (u < 0.0f) | (v_ < 0.0f) | (w_ < 0.0f);
-    int8 positive = (u > 0.0f) | (v_ > 0.0f) | (w_ > 0.0f);
-    float8 det = u + v_ + w_;
-    int8 hit = used & ~(negative & positive) & (det != 0.0f);
+    int4 negative = (u < 0.0f) | (v_ < 0.0f) | (w_ < 0.0f);
+    int4 positive = (u > 0.0f) | (v_ > 0.0f) | (w_ > 0.0f);
+    float4 det = u + v_ + w_;
+    int4 hit = used & ~(negative & positive) & (det != 0.0f);
 #if defined(MCRT_SINGLE_SIDED)
     /* A single-sided lane is hit from its front only: det > 0 where the ray meets the
      * counter-clockwise side (glTF 2.0 sec. 3.9.2, back-face culling; Woop et al. 2013, sec. 3,
      * BACKFACE_CULLING; the swap of x and y for dir.z < 0 keeps the sign). */
-    hit &= ~((as_int8(vload8(0, pk->index)) < (int8)(0)) & (det < 0.0f));
+    hit &= ~((as_int4(vload4(0, pk->index)) < (int4)(0)) & (det < 0.0f));
 #endif
     if (!any(hit)) return hit;
 
-    float8 az = q->shear_z * s.a_z, bz = q->shear_z * s.b_z, cz = q->shear_z * s.c_z;
-    float8 t_scaled = u * az + v_ * bz + w_ * cz;
-    float8 inv_det = 1.0f / det;
-    float8 t = t_scaled * inv_det;
+    float4 az = q->shear_z * s.a_z, bz = q->shear_z * s.b_z, cz = q->shear_z * s.c_z;
+    float4 t_scaled = u * az + v_ * bz + w_ * cz;
+    float4 inv_det = 1.0f / det;
+    float4 t = t_scaled * inv_det;
     *t_hit = t;
     *b1 = v_ * inv_det;
     *b2 = w_ * inv_det;
-    hit &= (t > (float8)(t_min)) & (t < (float8)(t_max));
+    hit &= (t > (float4)(t_min)) & (t < (float4)(t_max));
     if (!any(hit)) return hit;
 
-    float8 delta_t = packet_t_rounding_bound(&s, az, bz, cz, inv_det);
+    float4 delta_t = packet_t_rounding_bound(&s, az, bz, cz, inv_det);
     *delta = delta_t;
     if (!bounded) return hit;
-    return hit & (t > delta_t) & (t < (float8)(t_max) - delta_t);
+    return hit & (t > delta_t) & (t < (float4)(t_max) - delta_t);
 }
 
 /* δt of lane `lane` of a packet for the ray (t_rounding_bound), with the test's own arithmetic. */
 inline float lane_t_rounding_bound(const PacketRay* q, global const TrianglePacket* pk,
                                    uint lane) {
     ShearedPacket s = shear_packet(q, pk);
-    float8 det = (s.cx * s.by - s.cy * s.bx) + (s.ax * s.cy - s.ay * s.cx) +
+    float4 det = (s.cx * s.by - s.cy * s.bx) + (s.ax * s.cy - s.ay * s.cx) +
                  (s.bx * s.ay - s.by * s.ax);
-    float8 d = packet_t_rounding_bound(&s, q->shear_z * s.a_z, q->shear_z * s.b_z,
+    float4 d = packet_t_rounding_bound(&s, q->shear_z * s.a_z, q->shear_z * s.b_z,
                                        q->shear_z * s.c_z, 1.0f / det);
-    float lanes[8];
-    vstore8(d, 0, lanes);
-    return lanes[lane];
+    return lane == 0u ? d.x : lane == 1u ? d.y : lane == 2u ? d.z : d.w;
 }
 
 #endif

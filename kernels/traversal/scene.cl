@@ -159,8 +159,8 @@ inline SurfacePoint surface_point(const SceneView* scene, const Ray* r, const Hi
     uint lane = hit->lane % MCRT_PACKET_WIDTH;
     global const float* v =
         (global const float*)scene->packets[hit->lane / MCRT_PACKET_WIDTH].v + lane;
-    float3 p0 = (float3)(v[0], v[8], v[16]), p1 = (float3)(v[24], v[32], v[40]),
-           p2 = (float3)(v[48], v[56], v[64]);
+    float3 p0 = (float3)(v[0], v[4], v[8]), p1 = (float3)(v[12], v[16], v[20]),
+           p2 = (float3)(v[24], v[28], v[32]);
     float3 e1 = p1 - p0, e2 = p2 - p0;
     TriangleInfo info = scene->triangle_info[hit->lane];
     SurfacePoint sp;
